@@ -1,0 +1,421 @@
+//! Declarative field layouts: where a named value sits in a byte string.
+//!
+//! Every table of the seeds that splits bytes into labelled fields (UM0932
+//! Tables 8, 19, 35-39, 45, 48, 53-62) is written once as a `&[Field]`.
+//! The typed codecs read and write through these descriptions, the generic
+//! decoder prints them, console forms are rendered from them and the
+//! simulator validates with them: a bit position is never written twice.
+
+use alloc::string::String;
+use alloc::vec::Vec;
+use core::fmt;
+
+/// Byte order of a multi-byte field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Order {
+    /// Most significant byte first (UM0932 data fields, see protocol notes).
+    MsbFirst,
+    /// Least significant byte first (ST7570 sub-fields, checksums).
+    LsbFirst,
+}
+
+/// What a field's bits mean.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// An unsigned number.
+    Uint,
+    /// A two's complement signed number.
+    Int,
+    /// A yes/no bit (1 = yes).
+    Flag,
+    /// A value chosen from a list; the index is the raw value. An empty name
+    /// marks a value the seed does not define: it is preserved, shown as a
+    /// number and refused by validation.
+    Enum(&'static [&'static str]),
+    /// Opaque bytes (keys, payloads), printed as hex.
+    Bytes,
+}
+
+/// One labelled field of a layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Field {
+    /// The seed's label in snake_case (`high_frequency`), used as JSON key.
+    pub name: &'static str,
+    /// The seed's label as printed in the manual (`High frequency`).
+    pub label: &'static str,
+    /// First byte of the field.
+    pub offset: usize,
+    /// Number of bytes the field spans (for [`Kind::Bytes`]: 0 = to the end).
+    pub size: usize,
+    /// For a field narrower than its bytes: (lowest bit, width).
+    pub bits: Option<(u8, u8)>,
+    /// What the value means.
+    pub kind: Kind,
+    /// Byte order when `size > 1`.
+    pub order: Order,
+    /// Unit of a number (`Hz`, `ms`, `13 µs`), empty when none.
+    pub unit: &'static str,
+    /// Smallest value the chip accepts (numbers only).
+    pub min: i64,
+    /// Largest value the chip accepts (numbers only).
+    pub max: i64,
+    /// Whether the host may set it (false for reserved and unused bits).
+    pub settable: bool,
+}
+
+/// A decoded field value.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Value {
+    /// An unsigned number.
+    Uint(u32),
+    /// A signed number.
+    Int(i32),
+    /// A yes/no bit.
+    Flag(bool),
+    /// An enumerated value: its raw number and the seed's name, if defined.
+    Enum {
+        /// The raw value.
+        raw: u8,
+        /// The seed's name for it (`Q-PSK`), `None` for an undefined value.
+        name: Option<&'static str>,
+    },
+    /// Opaque bytes.
+    Bytes(Vec<u8>),
+}
+
+impl Value {
+    /// The value as a plain number, for numbers, flags and enums.
+    pub fn as_i64(&self) -> Option<i64> {
+        match *self {
+            Value::Uint(v) => Some(v as i64),
+            Value::Int(v) => Some(v as i64),
+            Value::Flag(v) => Some(v as i64),
+            Value::Enum { raw, .. } => Some(raw as i64),
+            Value::Bytes(_) => None,
+        }
+    }
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Uint(v) => write!(f, "{v}"),
+            Value::Int(v) => write!(f, "{v}"),
+            Value::Flag(v) => write!(f, "{v}"),
+            Value::Enum { name: Some(n), .. } => f.write_str(n),
+            Value::Enum { raw, name: None } => write!(f, "{raw} (undefined)"),
+            Value::Bytes(b) => f.write_str(&crate::hex::encode(b)),
+        }
+    }
+}
+
+/// Why a value does not fit a field, in words for the user.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldError {
+    /// The field's snake_case name.
+    pub field: &'static str,
+    /// What is wrong and what is allowed.
+    pub reason: String,
+}
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.field, self.reason)
+    }
+}
+
+impl Field {
+    const fn base(name: &'static str, label: &'static str, offset: usize, size: usize, kind: Kind) -> Field {
+        Field {
+            name,
+            label,
+            offset,
+            size,
+            bits: None,
+            kind,
+            order: Order::MsbFirst,
+            unit: "",
+            min: 0,
+            max: 0,
+            settable: true,
+        }
+    }
+
+    /// An unsigned number filling `size` whole bytes.
+    pub const fn uint(name: &'static str, label: &'static str, offset: usize, size: usize) -> Field {
+        let mut f = Field::base(name, label, offset, size, Kind::Uint);
+        f.max = (1i64 << (8 * size)) - 1;
+        f
+    }
+
+    /// A signed number filling `size` whole bytes.
+    pub const fn int(name: &'static str, label: &'static str, offset: usize, size: usize) -> Field {
+        let mut f = Field::base(name, label, offset, size, Kind::Int);
+        f.min = -(1i64 << (8 * size - 1));
+        f.max = (1i64 << (8 * size - 1)) - 1;
+        f
+    }
+
+    /// Opaque bytes; `size` 0 runs to the end of the data.
+    pub const fn bytes(name: &'static str, label: &'static str, offset: usize, size: usize) -> Field {
+        Field::base(name, label, offset, size, Kind::Bytes)
+    }
+
+    /// An unsigned number in bits `lo .. lo+width` of byte `offset`.
+    pub const fn bits_uint(name: &'static str, label: &'static str, offset: usize, lo: u8, width: u8) -> Field {
+        let mut f = Field::base(name, label, offset, 1, Kind::Uint);
+        f.bits = Some((lo, width));
+        f.max = (1i64 << width) - 1;
+        f
+    }
+
+    /// A yes/no bit.
+    pub const fn flag(name: &'static str, label: &'static str, offset: usize, bit: u8) -> Field {
+        let mut f = Field::base(name, label, offset, 1, Kind::Flag);
+        f.bits = Some((bit, 1));
+        f.max = 1;
+        f
+    }
+
+    /// An enumerated value in bits `lo .. lo+width` of byte `offset`.
+    pub const fn enumeration(
+        name: &'static str,
+        label: &'static str,
+        offset: usize,
+        lo: u8,
+        width: u8,
+        names: &'static [&'static str],
+    ) -> Field {
+        let mut f = Field::base(name, label, offset, 1, Kind::Enum(names));
+        f.bits = Some((lo, width));
+        f.max = names.len() as i64 - 1;
+        f
+    }
+
+    /// A reserved or unused bit range: decoded, preserved, never set by forms.
+    pub const fn reserved(name: &'static str, label: &'static str, offset: usize, lo: u8, width: u8) -> Field {
+        let mut f = Field::bits_uint(name, label, offset, lo, width);
+        f.settable = false;
+        f
+    }
+
+    /// The same field with a unit.
+    pub const fn unit(mut self, unit: &'static str) -> Field {
+        self.unit = unit;
+        self
+    }
+
+    /// The same field with the range the chip accepts.
+    pub const fn range(mut self, min: i64, max: i64) -> Field {
+        self.min = min;
+        self.max = max;
+        self
+    }
+
+    /// The same field with another byte order.
+    pub const fn order(mut self, order: Order) -> Field {
+        self.order = order;
+        self
+    }
+
+    /// Number of bytes this field needs in `data` (to its last byte).
+    pub fn end(&self) -> usize {
+        self.offset + self.size
+    }
+
+    fn raw(&self, data: &[u8]) -> Option<u64> {
+        let bytes = data.get(self.offset..self.offset + self.size)?;
+        let mut v: u64 = 0;
+        match self.order {
+            Order::MsbFirst => bytes.iter().for_each(|b| v = v << 8 | *b as u64),
+            Order::LsbFirst => bytes.iter().rev().for_each(|b| v = v << 8 | *b as u64),
+        }
+        if let Some((lo, width)) = self.bits {
+            v = (v >> lo) & ((1u64 << width) - 1);
+        }
+        Some(v)
+    }
+
+    /// Reads the field as a number (flags and enums as their raw value).
+    /// `None` if `data` is too short or the field holds bytes.
+    pub fn get(&self, data: &[u8]) -> Option<i64> {
+        let raw = self.raw(data)?;
+        Some(match self.kind {
+            Kind::Int => {
+                let bits = self.bits.map_or(8 * self.size as u32, |(_, w)| w as u32);
+                let shift = 64 - bits;
+                ((raw << shift) as i64) >> shift
+            }
+            Kind::Bytes => return None,
+            _ => raw as i64,
+        })
+    }
+
+    /// Reads the field as a typed [`Value`]; `None` if `data` is too short.
+    pub fn read(&self, data: &[u8]) -> Option<Value> {
+        Some(match self.kind {
+            Kind::Bytes => {
+                let rest = data.get(self.offset..)?;
+                let bytes = if self.size == 0 { rest } else { rest.get(..self.size)? };
+                Value::Bytes(bytes.to_vec())
+            }
+            Kind::Uint => Value::Uint(self.get(data)? as u32),
+            Kind::Int => Value::Int(self.get(data)? as i32),
+            Kind::Flag => Value::Flag(self.get(data)? != 0),
+            Kind::Enum(names) => {
+                let raw = self.get(data)? as u8;
+                let name = names.get(raw as usize).copied().filter(|n| !n.is_empty());
+                Value::Enum { raw, name }
+            }
+        })
+    }
+
+    /// Writes a number into the field, leaving the other bits of its bytes
+    /// untouched. Values are truncated to the field's width; call
+    /// [`Field::check`] first to refuse them instead.
+    pub fn set(&self, data: &mut [u8], value: i64) {
+        let Some(bytes) = data.get_mut(self.offset..self.offset + self.size) else {
+            return;
+        };
+        let mut word: u64 = 0;
+        match self.order {
+            Order::MsbFirst => bytes.iter().for_each(|b| word = word << 8 | *b as u64),
+            Order::LsbFirst => bytes.iter().rev().for_each(|b| word = word << 8 | *b as u64),
+        }
+        let (lo, width) = self.bits.unwrap_or((0, 8 * self.size as u8));
+        let mask = if width >= 64 { u64::MAX } else { (1u64 << width) - 1 } << lo;
+        word = (word & !mask) | (((value as u64) << lo) & mask);
+        let n = bytes.len();
+        for (i, b) in bytes.iter_mut().enumerate() {
+            let shift = match self.order {
+                Order::MsbFirst => 8 * (n - 1 - i),
+                Order::LsbFirst => 8 * i,
+            };
+            *b = (word >> shift) as u8;
+        }
+    }
+
+    /// Checks that `value` is one the chip accepts for this field.
+    pub fn check(&self, value: i64) -> Result<(), FieldError> {
+        if let Kind::Enum(names) = self.kind {
+            let defined = usize::try_from(value)
+                .ok()
+                .and_then(|i| names.get(i))
+                .is_some_and(|n| !n.is_empty() && *n != "Reserved");
+            if !defined {
+                return Err(FieldError {
+                    field: self.name,
+                    reason: alloc::format!("{value} is not one of {}", self.allowed()),
+                });
+            }
+            return Ok(());
+        }
+        if !self.settable && value != 0 {
+            return Err(FieldError {
+                field: self.name,
+                reason: alloc::format!("{} bits must be 0, not {value}", self.label),
+            });
+        }
+        if value < self.min || value > self.max {
+            return Err(FieldError {
+                field: self.name,
+                reason: alloc::format!("{value} is out of range {}..={}{}", self.min, self.max, self.unit_suffix()),
+            });
+        }
+        Ok(())
+    }
+
+    fn unit_suffix(&self) -> String {
+        if self.unit.is_empty() {
+            String::new()
+        } else {
+            alloc::format!(" {}", self.unit)
+        }
+    }
+
+    /// The allowed values in words (`0 = B-PSK, 1 = Q-PSK, ...`).
+    pub fn allowed(&self) -> String {
+        match self.kind {
+            Kind::Enum(names) => {
+                let mut s = String::new();
+                for (i, n) in names.iter().enumerate() {
+                    if n.is_empty() || *n == "Reserved" {
+                        continue;
+                    }
+                    if !s.is_empty() {
+                        s.push_str(", ");
+                    }
+                    let _ = fmt::write(&mut s, format_args!("{i} = {n}"));
+                }
+                s
+            }
+            _ => alloc::format!("{}..={}{}", self.min, self.max, self.unit_suffix()),
+        }
+    }
+}
+
+/// Checks every settable field of `layout` in `data`; the first error wins.
+pub fn validate(layout: &[Field], data: &[u8]) -> Result<(), FieldError> {
+    for f in layout {
+        if matches!(f.kind, Kind::Bytes) {
+            continue;
+        }
+        if let Some(v) = f.get(data) {
+            f.check(v)?;
+        }
+    }
+    Ok(())
+}
+
+/// Finds a field of a layout by name.
+pub fn find(layout: &'static [Field], name: &str) -> Option<&'static Field> {
+    layout.iter().find(|f| f.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const NAMES: &[&str] = &["zero", "one", "", "Reserved"];
+
+    #[test]
+    fn reads_and_writes_bits_without_touching_neighbours() {
+        let f = Field::bits_uint("x", "X", 0, 3, 2);
+        let mut d = [0b1110_0111u8];
+        assert_eq!(f.get(&d), Some(0));
+        f.set(&mut d, 3);
+        assert_eq!(d[0], 0b1111_1111);
+        f.set(&mut d, 1);
+        assert_eq!(d[0], 0b1110_1111);
+    }
+
+    #[test]
+    fn multi_byte_orders_and_sign() {
+        let be = Field::int("z", "Z", 0, 2);
+        let le = Field::uint("u", "U", 0, 2).order(Order::LsbFirst);
+        let mut d = [0xFF, 0xFE];
+        assert_eq!(be.get(&d), Some(-2));
+        assert_eq!(le.get(&d), Some(0xFEFF));
+        be.set(&mut d, -300);
+        assert_eq!(d, [0xFE, 0xD4]);
+        assert_eq!(be.get(&d), Some(-300));
+        assert_eq!(be.get(&[1]), None, "short data is None, not a panic");
+    }
+
+    #[test]
+    fn enums_refuse_undefined_and_reserved_values() {
+        let f = Field::enumeration("e", "E", 0, 0, 2, NAMES);
+        assert!(f.check(1).is_ok());
+        assert!(f.check(2).is_err());
+        assert!(f.check(3).is_err());
+        assert_eq!(f.read(&[2]), Some(Value::Enum { raw: 2, name: None }));
+        assert_eq!(f.allowed(), "0 = zero, 1 = one");
+    }
+
+    #[test]
+    fn ranges_are_enforced_with_a_reason() {
+        let f = Field::uint("hz", "Hz", 0, 3).range(3000, 148_500).unit("Hz");
+        let e = f.check(200_000).unwrap_err();
+        assert_eq!(e.reason, "200000 is out of range 3000..=148500 Hz");
+    }
+}

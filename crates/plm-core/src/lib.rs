@@ -1,0 +1,29 @@
+//! The protocol core of PLM Console.
+//!
+//! `no_std` + `alloc`, no I/O and no clock: everything that knows a byte of
+//! the ST power line modems' host interfaces lives here, once, and the
+//! console, the simulator and the `plm` tool all call it.
+//!
+//! - [`link`]: local frames, checksum, ACK/NAK, status messages, the stream
+//!   decoder and the sans-IO host and device link engines (UM0932 3.2).
+//! - [`st7580`]: every ST7580 command (UM0932 3.3) and MIB object (UM0932 4).
+//! - [`field`]: the declarative field layouts that both the typed codecs and
+//!   the generic decoder/forms read, so a bit position is written once.
+//! - [`mib`]: the declarative MIB description (objects, access, defaults).
+//! - [`decode`]: the named-field view of a stream element that `plm decode`
+//!   prints and the console's traffic inspector shows.
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+extern crate alloc;
+#[cfg(test)]
+extern crate std;
+
+pub mod decode;
+pub mod field;
+pub mod hex;
+pub mod link;
+pub mod mib;
+pub mod st7580;
+pub mod time;

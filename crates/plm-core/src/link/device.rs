@@ -1,0 +1,264 @@
+//! The device-side link engine: the modem's half of the host interface,
+//! used by the simulated modems. Sans-IO like [`super::host`].
+//!
+//! Rules implemented (ST7580, UM0932 3.2.5-3.2.9):
+//! - on T_REQ low, answer with the status message as soon as not busy
+//!   (3.2.8); accept the host's frame only if its STX comes within T_SR;
+//! - ACK a frame with right length and checksum, NAK any other (3.2.8);
+//! - send frames with STX 02h unprompted (the modem is master, 3.2.5);
+//!   on NAK, any other frame or no ACK within T_ACK, repeat once with
+//!   STX 03h T_ACK after the frame, and count the repeat as delivered
+//!   whatever the answer (3.2.7);
+//! - drop a frame whose characters are more than T_IC apart (3.2.6).
+
+use super::host::Transmit;
+use super::rx::Receiver;
+use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
+use crate::time::{wire_time, Instant};
+use alloc::collections::VecDeque;
+use alloc::vec::Vec;
+
+/// What happened, for the device model and the simulator's trace.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum DeviceEvent {
+    /// An element arrived from the host.
+    Received(Element),
+    /// An element was sent to the host.
+    Sent(Element),
+    /// A host frame was accepted and acknowledged: a request to execute.
+    Request(LocalFrame),
+    /// A frame the device sent was acknowledged (`repeated`: only after
+    /// its STX 03h repeat, which counts as acknowledged by rule).
+    Delivered {
+        /// The frame.
+        frame: LocalFrame,
+        /// Whether it took the repeat.
+        repeated: bool,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum State {
+    Idle,
+    /// Status message sent: the host's STX must come before `deadline`.
+    AwaitHostFrame { deadline: Instant },
+    /// A frame is out (STX 02h): waiting for ACK until `deadline`, then the
+    /// repeat. `refused` once a NAK or another frame came instead.
+    AwaitAck { frame: LocalFrame, deadline: Instant },
+}
+
+/// The device-side link engine.
+#[derive(Debug, Clone)]
+pub struct DeviceEngine {
+    dialect: Dialect,
+    timeouts: Timeouts,
+    baud: u32,
+    state: State,
+    rx: Receiver,
+    queue: VecDeque<LocalFrame>,
+    status: StatusMessage,
+    treq: bool,
+    /// The current T_REQ assertion has been answered with a status message.
+    treq_served: bool,
+    /// The host's frame started within T_SR of the status message: the
+    /// frame being received is one the modem takes.
+    host_frame_open: bool,
+    transmits: VecDeque<Transmit>,
+    events: VecDeque<DeviceEvent>,
+}
+
+impl DeviceEngine {
+    /// A device engine for `dialect` at `baud`, with the reset timeouts.
+    pub fn new(dialect: Dialect, baud: u32) -> Self {
+        DeviceEngine {
+            dialect,
+            timeouts: Timeouts::default(),
+            baud,
+            state: State::Idle,
+            rx: Receiver::new(dialect, Source::Host),
+            queue: VecDeque::new(),
+            status: StatusMessage::new(dialect, &[0, 0, 0]),
+            treq: false,
+            treq_served: false,
+            host_frame_open: false,
+            transmits: VecDeque::new(),
+            events: VecDeque::new(),
+        }
+    }
+
+    /// The timeouts in use.
+    pub fn timeouts(&self) -> Timeouts {
+        self.timeouts
+    }
+
+    /// Applies new timeouts (a MIB 09h write).
+    pub fn set_timeouts(&mut self, timeouts: Timeouts) {
+        self.timeouts = timeouts;
+    }
+
+    /// The bits the next status messages carry.
+    pub fn set_status(&mut self, status: StatusMessage) {
+        self.status = status;
+    }
+
+    /// Whether the engine is idle with nothing queued.
+    pub fn is_idle(&self) -> bool {
+        self.state == State::Idle && self.queue.is_empty() && !self.rx.busy()
+    }
+
+    /// Forgets everything in flight (a modem reset).
+    pub fn reset(&mut self) {
+        self.state = State::Idle;
+        self.queue.clear();
+        self.rx = Receiver::new(self.dialect, Source::Host);
+        self.timeouts = Timeouts::default();
+        self.treq_served = self.treq;
+        self.host_frame_open = false;
+    }
+
+    /// Queues a frame for the host (confirms, errors, indications).
+    pub fn submit(&mut self, now: Instant, frame: LocalFrame) {
+        self.queue.push_back(frame);
+        self.advance(now);
+    }
+
+    /// The host changed T_REQ (`asserted`: pulled low).
+    pub fn set_treq(&mut self, now: Instant, asserted: bool) {
+        if asserted && !self.treq {
+            self.treq_served = false;
+        }
+        self.treq = asserted;
+        self.advance(now);
+    }
+
+    /// Bytes received from the host at `now`.
+    pub fn handle_rx(&mut self, now: Instant, bytes: &[u8]) {
+        let mut out = Vec::new();
+        for &b in bytes {
+            self.rx.push(now, b, self.timeouts.t_ic, &mut out);
+            // UM0932 3.2.8: the first byte of the frame must arrive
+            // within T_SR of the status message.
+            if let State::AwaitHostFrame { deadline } = self.state {
+                if self.rx.busy() && now <= deadline {
+                    self.state = State::Idle;
+                    self.host_frame_open = true;
+                }
+            }
+        }
+        for e in out {
+            self.on_element(now, e);
+        }
+        self.advance(now);
+    }
+
+    /// A deadline from [`DeviceEngine::poll_timeout`] has passed.
+    pub fn handle_timeout(&mut self, now: Instant) {
+        let mut out = Vec::new();
+        self.rx.timeout(now, self.timeouts.t_ic, &mut out);
+        for e in out {
+            self.on_element(now, e);
+        }
+        match &self.state {
+            State::AwaitHostFrame { deadline } if now > *deadline => self.state = State::Idle,
+            State::AwaitAck { frame, deadline } if now >= *deadline => {
+                let frame = frame.clone();
+                self.repeat(frame);
+            }
+            _ => {}
+        }
+        self.advance(now);
+    }
+
+    /// The next thing to write.
+    pub fn poll_transmit(&mut self) -> Option<Transmit> {
+        self.transmits.pop_front()
+    }
+
+    /// The next event.
+    pub fn poll_event(&mut self) -> Option<DeviceEvent> {
+        self.events.pop_front()
+    }
+
+    /// When [`DeviceEngine::handle_timeout`] must be called next.
+    pub fn poll_timeout(&self) -> Option<Instant> {
+        let state = match &self.state {
+            State::Idle => None,
+            State::AwaitHostFrame { deadline } => Some(*deadline + 1),
+            State::AwaitAck { deadline, .. } => Some(*deadline),
+        };
+        let rx = self.rx.deadline(self.timeouts.t_ic);
+        match (state, rx) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    fn send(&mut self, e: Element) {
+        self.transmits.push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
+        self.events.push_back(DeviceEvent::Sent(e));
+    }
+
+    fn send_frame(&mut self, frame: &LocalFrame) -> usize {
+        let bytes = frame.emit(self.dialect).unwrap_or_default();
+        let n = bytes.len();
+        self.events.push_back(DeviceEvent::Sent(Element::Frame {
+            frame: frame.clone(),
+            checksum: super::checksum(&bytes[1..n.saturating_sub(2)]),
+            checksum_ok: true,
+        }));
+        self.transmits.push_back(Transmit::Bytes(bytes));
+        n
+    }
+
+    /// UM0932 3.2.7: repeat once with STX 03h; that one counts as delivered.
+    fn repeat(&mut self, frame: LocalFrame) {
+        let again = LocalFrame { stx: Stx::Repeat, ..frame };
+        self.send_frame(&again);
+        self.state = State::Idle;
+        self.events.push_back(DeviceEvent::Delivered { frame: LocalFrame { stx: Stx::First, ..again }, repeated: true });
+    }
+
+    fn on_element(&mut self, _now: Instant, e: Element) {
+        self.events.push_back(DeviceEvent::Received(e.clone()));
+        match (&self.state, e) {
+            (State::AwaitAck { frame, .. }, Element::Ack) => {
+                let frame = frame.clone();
+                self.state = State::Idle;
+                self.events.push_back(DeviceEvent::Delivered { frame, repeated: false });
+            }
+            // NAK or another frame: the repeat still waits for T_ACK (3.2.7).
+            (State::AwaitAck { .. }, _) => {}
+            // A frame nobody asked for with T_REQ is ignored (3.2.8).
+            (_, Element::Frame { .. }) if !self.host_frame_open => {}
+            (_, Element::Frame { frame, checksum_ok, .. }) => {
+                self.host_frame_open = false;
+                if checksum_ok {
+                    self.send(Element::Ack);
+                    self.events.push_back(DeviceEvent::Request(frame));
+                } else {
+                    self.send(Element::Nak);
+                }
+            }
+            (_, Element::Garbage { .. }) => self.host_frame_open = false,
+            _ => {}
+        }
+    }
+
+    fn advance(&mut self, now: Instant) {
+        if self.state != State::Idle || self.rx.busy() {
+            return;
+        }
+        if self.treq && !self.treq_served {
+            self.treq_served = true;
+            let status = Element::Status(self.status);
+            let n = self.dialect.status_len();
+            self.send(status);
+            self.state = State::AwaitHostFrame { deadline: now + wire_time(n, self.baud) + self.timeouts.t_sr };
+            return;
+        }
+        if let Some(frame) = self.queue.pop_front() {
+            let n = self.send_frame(&frame);
+            self.state = State::AwaitAck { frame, deadline: now + wire_time(n, self.baud) + self.timeouts.t_ack };
+        }
+    }
+}

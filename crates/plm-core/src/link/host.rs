@@ -1,0 +1,368 @@
+//! The host-side link engine (the console is the host), sans-IO after
+//! quinn-proto: no port, no clock. The driver feeds bytes and time in and
+//! takes bytes, T_REQ levels and events out.
+//!
+//! Rules implemented (ST7580, UM0932 3.2.5-3.2.9):
+//! - to send, pull T_REQ low and wait for the status message (3.2.8);
+//! - send the frame with STX 02h, release T_REQ once STX is out (3.2.8);
+//! - expect ACK within T_ACK of the frame's last byte; on NAK or silence
+//!   restart the whole sequence (3.2.8), at most `max_attempts` times;
+//! - ACK every modem frame with a right length and checksum, NAK the
+//!   others (3.2.7); a frame with STX 03h that repeats the frame just
+//!   accepted is acknowledged but not reported again (3.2.7);
+//! - drop a frame whose characters are more than T_IC apart (3.2.6).
+//!
+//! Decisions where UM0932 is silent are in docs/protocol-notes.md
+//! ("Host link engine").
+
+use super::rx::Receiver;
+use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
+use crate::time::{wire_time, Duration, Instant};
+use alloc::collections::VecDeque;
+use alloc::vec::Vec;
+
+/// Something the driver must do on the wire.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Transmit {
+    /// Write these bytes.
+    Bytes(Vec<u8>),
+    /// Set T_REQ: `asserted` means pulled low (a request to send).
+    TReq {
+        /// Whether T_REQ is asserted (low).
+        asserted: bool,
+    },
+}
+
+/// Identifies a submitted frame in later events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Ticket(pub u32);
+
+/// Why a submitted frame was not delivered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkError {
+    /// No status message came after T_REQ, on every attempt.
+    NoStatus,
+    /// The modem answered NAK on the last attempt.
+    Nak,
+    /// No ACK or NAK within T_ACK on the last attempt.
+    NoAck,
+    /// The frame cannot be emitted (too long for the dialect).
+    Unencodable,
+}
+
+impl core::fmt::Display for LinkError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            LinkError::NoStatus => "the modem did not answer T_REQ with a status message: check the cable, the T_REQ wiring (RTS) and its polarity",
+            LinkError::Nak => "the modem refused the frame (NAK) on every attempt: check the baud rate",
+            LinkError::NoAck => "the modem did not acknowledge the frame within T_ACK: check the baud rate and the cable",
+            LinkError::Unencodable => "the frame is too long for a local frame",
+        })
+    }
+}
+
+/// What happened, for the layers above and the traffic inspector.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Event {
+    /// An element arrived from the modem (every one, for the inspector).
+    Received(Element),
+    /// An element was sent to the modem.
+    Sent(Element),
+    /// A modem frame was accepted and acknowledged.
+    Frame(LocalFrame),
+    /// The modem repeated (STX 03h) a frame already accepted; it was
+    /// acknowledged and is not reported again as [`Event::Frame`].
+    Repeat(LocalFrame),
+    /// The modem acknowledged a submitted frame.
+    Delivered(Ticket),
+    /// A submitted frame was given up after every attempt.
+    Failed(Ticket, LinkError),
+    /// An attempt failed and the whole sequence restarts.
+    Retry {
+        /// The frame concerned.
+        ticket: Ticket,
+        /// Attempts made so far.
+        attempt: u8,
+        /// Why the attempt failed.
+        cause: LinkError,
+    },
+}
+
+/// Settings of the host engine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HostConfig {
+    /// Host-interface timeouts (keep in step with MIB 09h).
+    pub timeouts: Timeouts,
+    /// UART baud rate, to know when written bytes have left.
+    pub baud: u32,
+    /// Attempts per frame before [`Event::Failed`].
+    pub max_attempts: u8,
+}
+
+impl Default for HostConfig {
+    fn default() -> Self {
+        HostConfig { timeouts: Timeouts::default(), baud: 57_600, max_attempts: 3 }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum State {
+    /// Nothing in flight; `not_before` spaces a retry from the last attempt.
+    Idle { not_before: Instant },
+    /// T_REQ is low, waiting for the status message.
+    AwaitStatus { deadline: Instant },
+    /// The frame is out, waiting for ACK/NAK.
+    AwaitAck { deadline: Instant },
+}
+
+#[derive(Debug, Clone)]
+struct Pending {
+    ticket: Ticket,
+    bytes: Vec<u8>,
+    frame: LocalFrame,
+    attempts: u8,
+}
+
+/// The host-side link engine.
+#[derive(Debug, Clone)]
+pub struct HostEngine {
+    dialect: Dialect,
+    config: HostConfig,
+    state: State,
+    rx: Receiver,
+    queue: VecDeque<Pending>,
+    current: Option<Pending>,
+    next_ticket: u32,
+    transmits: VecDeque<Transmit>,
+    events: VecDeque<Event>,
+    /// The last frame accepted with STX 02h and when, to recognise its
+    /// repeat (UM0932 3.2.7).
+    last_accepted: Option<(LocalFrame, Instant)>,
+    last_status: Option<StatusMessage>,
+}
+
+impl HostEngine {
+    /// A host engine for `dialect`. Only the ST7580 rules are implemented.
+    pub fn new(dialect: Dialect, config: HostConfig) -> Self {
+        HostEngine {
+            dialect,
+            config,
+            state: State::Idle { not_before: 0 },
+            rx: Receiver::new(dialect, Source::Modem),
+            queue: VecDeque::new(),
+            current: None,
+            next_ticket: 0,
+            transmits: VecDeque::new(),
+            events: VecDeque::new(),
+            last_accepted: None,
+            last_status: None,
+        }
+    }
+
+    /// The settings in use.
+    pub fn config(&self) -> HostConfig {
+        self.config
+    }
+
+    /// Changes the timeouts (after a MIB 09h write was confirmed) or baud.
+    pub fn set_config(&mut self, config: HostConfig) {
+        self.config = config;
+    }
+
+    /// The last status message received.
+    pub fn last_status(&self) -> Option<StatusMessage> {
+        self.last_status
+    }
+
+    /// Frames queued or in flight.
+    pub fn pending(&self) -> usize {
+        self.queue.len() + self.current.is_some() as usize
+    }
+
+    /// Queues a frame for the modem; its fate comes as
+    /// [`Event::Delivered`] or [`Event::Failed`] with the returned ticket.
+    pub fn submit(&mut self, now: Instant, frame: LocalFrame) -> Ticket {
+        let ticket = Ticket(self.next_ticket);
+        self.next_ticket = self.next_ticket.wrapping_add(1);
+        match frame.emit(self.dialect) {
+            Ok(bytes) => self.queue.push_back(Pending { ticket, bytes, frame, attempts: 0 }),
+            Err(_) => self.events.push_back(Event::Failed(ticket, LinkError::Unencodable)),
+        }
+        self.advance(now);
+        ticket
+    }
+
+    /// Drops every queued frame and any exchange in flight (the port was
+    /// lost or closed); each gets [`Event::Failed`] with `cause`.
+    pub fn abort(&mut self, cause: LinkError) {
+        for p in self.current.take().into_iter().chain(self.queue.drain(..)) {
+            self.events.push_back(Event::Failed(p.ticket, cause));
+        }
+        if !matches!(self.state, State::Idle { .. }) {
+            self.transmits.push_back(Transmit::TReq { asserted: false });
+        }
+        self.state = State::Idle { not_before: 0 };
+    }
+
+    /// Bytes received from the modem at `now`.
+    pub fn handle_rx(&mut self, now: Instant, bytes: &[u8]) {
+        let mut out = Vec::new();
+        for &b in bytes {
+            self.rx.push(now, b, self.config.timeouts.t_ic, &mut out);
+            // Any modem activity while waiting for the status message means
+            // the modem is busy with its own frame: keep waiting.
+            if let State::AwaitStatus { deadline } = &mut self.state {
+                *deadline = (*deadline).max(now + self.config.timeouts.t_sr);
+            }
+        }
+        for e in out {
+            self.on_element(now, e);
+        }
+        self.advance(now);
+    }
+
+    /// A deadline from [`HostEngine::poll_timeout`] has passed.
+    pub fn handle_timeout(&mut self, now: Instant) {
+        let mut out = Vec::new();
+        self.rx.timeout(now, self.config.timeouts.t_ic, &mut out);
+        for e in out {
+            self.on_element(now, e);
+        }
+        match self.state {
+            State::AwaitStatus { deadline } if now >= deadline => {
+                self.transmits.push_back(Transmit::TReq { asserted: false });
+                self.attempt_failed(now, LinkError::NoStatus);
+            }
+            State::AwaitAck { deadline } if now >= deadline => self.attempt_failed(now, LinkError::NoAck),
+            _ => {}
+        }
+        self.advance(now);
+    }
+
+    /// The next thing to write or signal.
+    pub fn poll_transmit(&mut self) -> Option<Transmit> {
+        self.transmits.pop_front()
+    }
+
+    /// The next event.
+    pub fn poll_event(&mut self) -> Option<Event> {
+        self.events.pop_front()
+    }
+
+    /// When [`HostEngine::handle_timeout`] must be called next.
+    pub fn poll_timeout(&self) -> Option<Instant> {
+        let state = match self.state {
+            State::Idle { not_before } if self.current.is_some() || !self.queue.is_empty() => Some(not_before),
+            State::Idle { .. } => None,
+            State::AwaitStatus { deadline } | State::AwaitAck { deadline } => Some(deadline),
+        };
+        let rx = self.rx.deadline(self.config.timeouts.t_ic);
+        match (state, rx) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    fn send(&mut self, e: Element) {
+        self.transmits.push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
+        self.events.push_back(Event::Sent(e));
+    }
+
+    fn on_element(&mut self, now: Instant, e: Element) {
+        self.events.push_back(Event::Received(e.clone()));
+        match e {
+            Element::Frame { frame, checksum_ok, .. } => {
+                if !checksum_ok {
+                    self.last_accepted = None;
+                    self.send(Element::Nak);
+                    return;
+                }
+                // The ACK is sent at once, well within T_ACK.
+                self.send(Element::Ack);
+                let window = 2 * self.config.timeouts.t_ack + self.wire(frame.data.len() + 5);
+                let repeat = frame.stx == Stx::Repeat
+                    && self
+                        .last_accepted
+                        .as_ref()
+                        .is_some_and(|(f, at)| f.code == frame.code && f.data == frame.data && now <= at + window);
+                if repeat {
+                    self.last_accepted = None;
+                    self.events.push_back(Event::Repeat(frame));
+                } else {
+                    self.last_accepted = (frame.stx == Stx::First).then(|| (frame.clone(), now));
+                    self.events.push_back(Event::Frame(frame));
+                }
+            }
+            Element::Status(s) => {
+                self.last_status = Some(s);
+                if let State::AwaitStatus { .. } = self.state {
+                    self.send_current(now);
+                }
+            }
+            Element::Ack => {
+                if let State::AwaitAck { .. } = self.state {
+                    if let Some(p) = self.current.take() {
+                        self.events.push_back(Event::Delivered(p.ticket));
+                    }
+                    self.state = State::Idle { not_before: now };
+                }
+            }
+            Element::Nak => {
+                if let State::AwaitAck { .. } = self.state {
+                    self.attempt_failed(now, LinkError::Nak);
+                }
+            }
+            Element::Garbage { .. } => {
+                // A broken frame from the modem: it will repeat it.
+                self.last_accepted = None;
+            }
+        }
+    }
+
+    fn wire(&self, bytes: usize) -> Duration {
+        wire_time(bytes, self.config.baud)
+    }
+
+    /// Status received: send STX, release T_REQ, send the rest (3.2.8).
+    fn send_current(&mut self, now: Instant) {
+        let Some(p) = &self.current else { return };
+        let bytes = p.bytes.clone();
+        let frame = p.frame.clone();
+        self.transmits.push_back(Transmit::Bytes(bytes[..1].to_vec()));
+        self.transmits.push_back(Transmit::TReq { asserted: false });
+        self.transmits.push_back(Transmit::Bytes(bytes[1..].to_vec()));
+        self.events.push_back(Event::Sent(Element::Frame {
+            checksum: super::checksum(&bytes[1..bytes.len() - 2]),
+            frame,
+            checksum_ok: true,
+        }));
+        self.state = State::AwaitAck { deadline: now + self.wire(bytes.len()) + self.config.timeouts.t_ack };
+    }
+
+    fn attempt_failed(&mut self, now: Instant, cause: LinkError) {
+        // A restart is a new T_REQ falling edge: leave T_REQ high for T_IC
+        // so that the modem sees the edge.
+        self.state = State::Idle { not_before: now + self.config.timeouts.t_ic };
+        let Some(p) = self.current.take() else { return };
+        if p.attempts >= self.config.max_attempts {
+            self.events.push_back(Event::Failed(p.ticket, cause));
+        } else {
+            self.events.push_back(Event::Retry { ticket: p.ticket, attempt: p.attempts, cause });
+            self.current = Some(p);
+        }
+    }
+
+    fn advance(&mut self, now: Instant) {
+        let State::Idle { not_before } = self.state else { return };
+        if now < not_before {
+            return;
+        }
+        if self.current.is_none() {
+            self.current = self.queue.pop_front();
+        }
+        let Some(p) = &mut self.current else { return };
+        p.attempts += 1;
+        self.transmits.push_back(Transmit::TReq { asserted: true });
+        self.state = State::AwaitStatus { deadline: now + self.config.timeouts.t_sr };
+    }
+}

@@ -1,0 +1,1 @@
+//! Declarative MIB description (filled in with the ST7580 codec).

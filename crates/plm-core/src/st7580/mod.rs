@@ -1,0 +1,1 @@
+//! ST7580 commands and MIB (UM0932 3.3, 4).
