@@ -1,0 +1,61 @@
+//! `cargo xtask bench`: the performance figures of DESIGN.md, measured by
+//! programs that print their own results (never by timed tests).
+
+use crate::util::{root, run_steps, Cmd, Result, Step};
+
+/// One benchmark: a program that prints its figures, and the source file
+/// whose absence means it is not written yet.
+struct Bench {
+    name: &'static str,
+    /// Relative to the workspace root; any one of them will do.
+    sources: &'static [&'static str],
+    cmd: Cmd,
+}
+
+/// Append new benchmarks here (link latency, command rate, RFU, size...).
+fn benches() -> Vec<Bench> {
+    vec![Bench {
+        name: "decoder throughput (native)",
+        sources: &[
+            "crates/plm-core/examples/bench_decode.rs",
+            "crates/plm-core/examples/bench_decode/main.rs",
+        ],
+        cmd: Cmd::new("cargo").args([
+            "run",
+            "--profile",
+            "bench-native",
+            "-p",
+            "plm-core",
+            "--example",
+            "bench_decode",
+        ]),
+    }]
+}
+
+/// Runs every benchmark; all must exist.
+pub fn run() -> Result {
+    let root = root();
+    let benches = benches();
+    let missing: Vec<String> = benches
+        .iter()
+        .filter(|b| !b.sources.iter().any(|s| root.join(s).exists()))
+        .map(|b| {
+            format!(
+                "`{}` is not written yet: {} is missing",
+                b.name, b.sources[0]
+            )
+        })
+        .collect();
+    if !missing.is_empty() {
+        return Err(format!("cannot bench: {}", missing.join("; ")));
+    }
+    println!(
+        "bench: {} benchmark(s); each prints its own figures",
+        benches.len()
+    );
+    let steps: Vec<Step> = benches
+        .into_iter()
+        .map(|b| Step::cmd(b.name, b.cmd))
+        .collect();
+    run_steps("bench", &steps, false)
+}
