@@ -61,6 +61,9 @@ pub struct Field {
     pub max: i64,
     /// Whether the host may set it (false for reserved and unused bits).
     pub settable: bool,
+    /// A raw value that means "no value" (UM0932 Table 39: SNR 255 for
+    /// FSK frames); it reads as [`Value::Absent`].
+    pub absent: Option<u64>,
 }
 
 /// A decoded field value.
@@ -81,6 +84,8 @@ pub enum Value {
     },
     /// Opaque bytes.
     Bytes(Vec<u8>),
+    /// The field holds its "no value" marker.
+    Absent,
 }
 
 impl Value {
@@ -91,7 +96,7 @@ impl Value {
             Value::Int(v) => Some(v as i64),
             Value::Flag(v) => Some(v as i64),
             Value::Enum { raw, .. } => Some(raw as i64),
-            Value::Bytes(_) => None,
+            Value::Bytes(_) | Value::Absent => None,
         }
     }
 }
@@ -105,6 +110,7 @@ impl fmt::Display for Value {
             Value::Enum { name: Some(n), .. } => f.write_str(n),
             Value::Enum { raw, name: None } => write!(f, "{raw} (undefined)"),
             Value::Bytes(b) => f.write_str(&crate::hex::encode(b)),
+            Value::Absent => f.write_str("no value"),
         }
     }
 }
@@ -125,7 +131,13 @@ impl fmt::Display for FieldError {
 }
 
 impl Field {
-    const fn base(name: &'static str, label: &'static str, offset: usize, size: usize, kind: Kind) -> Field {
+    const fn base(
+        name: &'static str,
+        label: &'static str,
+        offset: usize,
+        size: usize,
+        kind: Kind,
+    ) -> Field {
         Field {
             name,
             label,
@@ -138,11 +150,17 @@ impl Field {
             min: 0,
             max: 0,
             settable: true,
+            absent: None,
         }
     }
 
     /// An unsigned number filling `size` whole bytes.
-    pub const fn uint(name: &'static str, label: &'static str, offset: usize, size: usize) -> Field {
+    pub const fn uint(
+        name: &'static str,
+        label: &'static str,
+        offset: usize,
+        size: usize,
+    ) -> Field {
         let mut f = Field::base(name, label, offset, size, Kind::Uint);
         f.max = (1i64 << (8 * size)) - 1;
         f
@@ -157,12 +175,23 @@ impl Field {
     }
 
     /// Opaque bytes; `size` 0 runs to the end of the data.
-    pub const fn bytes(name: &'static str, label: &'static str, offset: usize, size: usize) -> Field {
+    pub const fn bytes(
+        name: &'static str,
+        label: &'static str,
+        offset: usize,
+        size: usize,
+    ) -> Field {
         Field::base(name, label, offset, size, Kind::Bytes)
     }
 
     /// An unsigned number in bits `lo .. lo+width` of byte `offset`.
-    pub const fn bits_uint(name: &'static str, label: &'static str, offset: usize, lo: u8, width: u8) -> Field {
+    pub const fn bits_uint(
+        name: &'static str,
+        label: &'static str,
+        offset: usize,
+        lo: u8,
+        width: u8,
+    ) -> Field {
         let mut f = Field::base(name, label, offset, 1, Kind::Uint);
         f.bits = Some((lo, width));
         f.max = (1i64 << width) - 1;
@@ -193,7 +222,13 @@ impl Field {
     }
 
     /// A reserved or unused bit range: decoded, preserved, never set by forms.
-    pub const fn reserved(name: &'static str, label: &'static str, offset: usize, lo: u8, width: u8) -> Field {
+    pub const fn reserved(
+        name: &'static str,
+        label: &'static str,
+        offset: usize,
+        lo: u8,
+        width: u8,
+    ) -> Field {
         let mut f = Field::bits_uint(name, label, offset, lo, width);
         f.settable = false;
         f
@@ -209,6 +244,12 @@ impl Field {
     pub const fn range(mut self, min: i64, max: i64) -> Field {
         self.min = min;
         self.max = max;
+        self
+    }
+
+    /// The same field with a raw value that means "no value".
+    pub const fn absent_when(mut self, raw: u64) -> Field {
+        self.absent = Some(raw);
         self
     }
 
@@ -253,10 +294,17 @@ impl Field {
 
     /// Reads the field as a typed [`Value`]; `None` if `data` is too short.
     pub fn read(&self, data: &[u8]) -> Option<Value> {
+        if self.absent.is_some() && self.raw(data) == self.absent {
+            return Some(Value::Absent);
+        }
         Some(match self.kind {
             Kind::Bytes => {
                 let rest = data.get(self.offset..)?;
-                let bytes = if self.size == 0 { rest } else { rest.get(..self.size)? };
+                let bytes = if self.size == 0 {
+                    rest
+                } else {
+                    rest.get(..self.size)?
+                };
                 Value::Bytes(bytes.to_vec())
             }
             Kind::Uint => Value::Uint(self.get(data)? as u32),
@@ -280,10 +328,17 @@ impl Field {
         let mut word: u64 = 0;
         match self.order {
             Order::MsbFirst => bytes.iter().for_each(|b| word = word << 8 | *b as u64),
-            Order::LsbFirst => bytes.iter().rev().for_each(|b| word = word << 8 | *b as u64),
+            Order::LsbFirst => bytes
+                .iter()
+                .rev()
+                .for_each(|b| word = word << 8 | *b as u64),
         }
         let (lo, width) = self.bits.unwrap_or((0, 8 * self.size as u8));
-        let mask = if width >= 64 { u64::MAX } else { (1u64 << width) - 1 } << lo;
+        let mask = if width >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << width) - 1
+        } << lo;
         word = (word & !mask) | (((value as u64) << lo) & mask);
         let n = bytes.len();
         for (i, b) in bytes.iter_mut().enumerate() {
@@ -319,7 +374,12 @@ impl Field {
         if value < self.min || value > self.max {
             return Err(FieldError {
                 field: self.name,
-                reason: alloc::format!("{value} is out of range {}..={}{}", self.min, self.max, self.unit_suffix()),
+                reason: alloc::format!(
+                    "{value} is out of range {}..={}{}",
+                    self.min,
+                    self.max,
+                    self.unit_suffix()
+                ),
             });
         }
         Ok(())
@@ -414,7 +474,9 @@ mod tests {
 
     #[test]
     fn ranges_are_enforced_with_a_reason() {
-        let f = Field::uint("hz", "Hz", 0, 3).range(3000, 148_500).unit("Hz");
+        let f = Field::uint("hz", "Hz", 0, 3)
+            .range(3000, 148_500)
+            .unit("Hz");
         let e = f.check(200_000).unwrap_err();
         assert_eq!(e.reason, "200000 is out of range 3000..=148500 Hz");
     }

@@ -65,7 +65,10 @@ pub fn parse(text: &str) -> Result<Vec<u8>, HexError> {
             i += 1;
         }
         if i < chars.len() && !is_separator(chars[i]) {
-            return Err(HexError::BadChar { ch: chars[i], at: i });
+            return Err(HexError::BadChar {
+                ch: chars[i],
+                at: i,
+            });
         }
         if digits.is_empty() {
             return Err(HexError::BadChar {
@@ -101,7 +104,14 @@ mod tests {
     #[test]
     fn accepts_the_separators_people_use() {
         let want = alloc::vec![0x02, 0x00, 0x2c, 0x2c, 0x00];
-        for text in ["02 00 2c 2c 00", "02.00.2C.2C.00", "02:00:2c:2c:00", "02002c2c00", "02h 00h 2Ch 2ch 00h", "0x02 0x00 0x2c2c00"] {
+        for text in [
+            "02 00 2c 2c 00",
+            "02.00.2C.2C.00",
+            "02:00:2c:2c:00",
+            "02002c2c00",
+            "02h 00h 2Ch 2ch 00h",
+            "0x02 0x00 0x2c2c00",
+        ] {
             assert_eq!(parse(text).unwrap(), want, "{text}");
         }
     }

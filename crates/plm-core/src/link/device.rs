@@ -41,10 +41,15 @@ pub enum DeviceEvent {
 enum State {
     Idle,
     /// Status message sent: the host's STX must come before `deadline`.
-    AwaitHostFrame { deadline: Instant },
+    AwaitHostFrame {
+        deadline: Instant,
+    },
     /// A frame is out (STX 02h): waiting for ACK until `deadline`, then the
     /// repeat. `refused` once a NAK or another frame came instead.
-    AwaitAck { frame: LocalFrame, deadline: Instant },
+    AwaitAck {
+        frame: LocalFrame,
+        deadline: Instant,
+    },
 }
 
 /// The device-side link engine.
@@ -194,7 +199,8 @@ impl DeviceEngine {
     }
 
     fn send(&mut self, e: Element) {
-        self.transmits.push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
+        self.transmits
+            .push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
         self.events.push_back(DeviceEvent::Sent(e));
     }
 
@@ -212,10 +218,19 @@ impl DeviceEngine {
 
     /// UM0932 3.2.7: repeat once with STX 03h; that one counts as delivered.
     fn repeat(&mut self, frame: LocalFrame) {
-        let again = LocalFrame { stx: Stx::Repeat, ..frame };
+        let again = LocalFrame {
+            stx: Stx::Repeat,
+            ..frame
+        };
         self.send_frame(&again);
         self.state = State::Idle;
-        self.events.push_back(DeviceEvent::Delivered { frame: LocalFrame { stx: Stx::First, ..again }, repeated: true });
+        self.events.push_back(DeviceEvent::Delivered {
+            frame: LocalFrame {
+                stx: Stx::First,
+                ..again
+            },
+            repeated: true,
+        });
     }
 
     fn on_element(&mut self, _now: Instant, e: Element) {
@@ -224,13 +239,21 @@ impl DeviceEngine {
             (State::AwaitAck { frame, .. }, Element::Ack) => {
                 let frame = frame.clone();
                 self.state = State::Idle;
-                self.events.push_back(DeviceEvent::Delivered { frame, repeated: false });
+                self.events.push_back(DeviceEvent::Delivered {
+                    frame,
+                    repeated: false,
+                });
             }
             // NAK or another frame: the repeat still waits for T_ACK (3.2.7).
             (State::AwaitAck { .. }, _) => {}
             // A frame nobody asked for with T_REQ is ignored (3.2.8).
             (_, Element::Frame { .. }) if !self.host_frame_open => {}
-            (_, Element::Frame { frame, checksum_ok, .. }) => {
+            (
+                _,
+                Element::Frame {
+                    frame, checksum_ok, ..
+                },
+            ) => {
                 self.host_frame_open = false;
                 if checksum_ok {
                     self.send(Element::Ack);
@@ -253,12 +276,17 @@ impl DeviceEngine {
             let status = Element::Status(self.status);
             let n = self.dialect.status_len();
             self.send(status);
-            self.state = State::AwaitHostFrame { deadline: now + wire_time(n, self.baud) + self.timeouts.t_sr };
+            self.state = State::AwaitHostFrame {
+                deadline: now + wire_time(n, self.baud) + self.timeouts.t_sr,
+            };
             return;
         }
         if let Some(frame) = self.queue.pop_front() {
             let n = self.send_frame(&frame);
-            self.state = State::AwaitAck { frame, deadline: now + wire_time(n, self.baud) + self.timeouts.t_ack };
+            self.state = State::AwaitAck {
+                frame,
+                deadline: now + wire_time(n, self.baud) + self.timeouts.t_ack,
+            };
         }
     }
 }

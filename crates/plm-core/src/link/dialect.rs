@@ -16,8 +16,8 @@ impl Dialect {
     /// Bytes of a status message, including the leading `?`.
     pub const fn status_len(self) -> usize {
         match self {
-            Dialect::St7580 => 2,  // UM0932 Table 8
-            Dialect::St7570 => 4,  // ST7570 UM Table 11
+            Dialect::St7580 => 2, // UM0932 Table 8
+            Dialect::St7570 => 4, // ST7570 UM Table 11
         }
     }
 

@@ -36,7 +36,10 @@ impl StatusMessage {
         let len = (dialect.status_len() - 1).min(after_mark.len());
         let mut bytes = [0; 3];
         bytes[..len].copy_from_slice(&after_mark[..len]);
-        StatusMessage { bytes, len: len as u8 }
+        StatusMessage {
+            bytes,
+            len: len as u8,
+        }
     }
 
     /// The bytes after `?`.
@@ -104,7 +107,9 @@ impl Element {
     /// The bytes of the element exactly as they were on the wire.
     pub fn to_bytes(&self, dialect: Dialect) -> Vec<u8> {
         match self {
-            Element::Frame { frame, checksum, .. } => frame
+            Element::Frame {
+                frame, checksum, ..
+            } => frame
                 .emit_with_checksum(dialect, Some(*checksum))
                 .unwrap_or_default(),
             Element::Ack => alloc::vec![ACK],

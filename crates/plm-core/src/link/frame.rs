@@ -38,7 +38,9 @@ impl Stx {
 /// field up to the last data byte (or the command byte when there is no
 /// data), UM0932 Table 6. `bytes` is that span.
 pub fn checksum(bytes: &[u8]) -> u16 {
-    bytes.iter().fold(0u16, |acc, b| acc.wrapping_add(*b as u16))
+    bytes
+        .iter()
+        .fold(0u16, |acc, b| acc.wrapping_add(*b as u16))
 }
 
 /// Why a byte string is not a whole local frame.
@@ -60,7 +62,9 @@ impl fmt::Display for FrameError {
         match self {
             FrameError::NotStx(b) => write!(f, "{b:02x} is not a start of frame"),
             FrameError::BadLength(l) => write!(f, "length {l} is not allowed"),
-            FrameError::Truncated { needed } => write!(f, "frame truncated ({needed} bytes needed)"),
+            FrameError::Truncated { needed } => {
+                write!(f, "frame truncated ({needed} bytes needed)")
+            }
         }
     }
 }
@@ -84,7 +88,9 @@ impl<T: AsRef<[u8]>> Frame<T> {
             return Err(FrameError::NotStx(first));
         }
         let length = *b.get(1).ok_or(FrameError::Truncated { needed: 2 })?;
-        let data_len = dialect.data_len(length).ok_or(FrameError::BadLength(length))?;
+        let data_len = dialect
+            .data_len(length)
+            .ok_or(FrameError::BadLength(length))?;
         let needed = Dialect::frame_len(data_len);
         if b.len() < needed {
             return Err(FrameError::Truncated { needed });
@@ -165,9 +171,14 @@ impl fmt::Display for EmitError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             EmitError::DataTooLong { len, max } => {
-                write!(f, "data field of {len} bytes is longer than the {max} a local frame carries")
+                write!(
+                    f,
+                    "data field of {len} bytes is longer than the {max} a local frame carries"
+                )
             }
-            EmitError::RepeatNotInDialect => f.write_str("STX 03h (repeat) is only used by the ST7580"),
+            EmitError::RepeatNotInDialect => {
+                f.write_str("STX 03h (repeat) is only used by the ST7580")
+            }
         }
     }
 }
@@ -186,7 +197,11 @@ pub struct LocalFrame {
 impl LocalFrame {
     /// A first transmission (STX 02h) of `code` with `data`.
     pub fn new(code: u8, data: Vec<u8>) -> Self {
-        LocalFrame { stx: Stx::First, code, data }
+        LocalFrame {
+            stx: Stx::First,
+            code,
+            data,
+        }
     }
 
     /// Reads the frame of a checked view. The checksum is not judged here.
@@ -206,14 +221,20 @@ impl LocalFrame {
 
     /// The frame's bytes with the given checksum (to reproduce a received
     /// frame exactly, bad checksum included), or the right one for `None`.
-    pub fn emit_with_checksum(&self, dialect: Dialect, sum: Option<u16>) -> Result<Vec<u8>, EmitError> {
+    pub fn emit_with_checksum(
+        &self,
+        dialect: Dialect,
+        sum: Option<u16>,
+    ) -> Result<Vec<u8>, EmitError> {
         if !dialect.is_stx(self.stx.byte()) {
             return Err(EmitError::RepeatNotInDialect);
         }
-        let length = dialect.length_byte(self.data.len()).ok_or(EmitError::DataTooLong {
-            len: self.data.len(),
-            max: dialect.max_data(),
-        })?;
+        let length = dialect
+            .length_byte(self.data.len())
+            .ok_or(EmitError::DataTooLong {
+                len: self.data.len(),
+                max: dialect.max_data(),
+            })?;
         let mut out = Vec::with_capacity(Dialect::frame_len(self.data.len()));
         out.push(self.stx.byte());
         out.push(length);
@@ -250,10 +271,15 @@ mod tests {
 
     #[test]
     fn st7570_length_counts_command_data_and_checksum() {
-        let bytes = LocalFrame::new(0x51, vec![0; 16]).emit(Dialect::St7570).unwrap();
+        let bytes = LocalFrame::new(0x51, vec![0; 16])
+            .emit(Dialect::St7570)
+            .unwrap();
         assert_eq!(bytes[1], 19);
         assert_eq!(bytes.len(), 21);
-        assert_eq!(Frame::new_checked(&[0x02, 0x02, 0x00][..], Dialect::St7570).unwrap_err(), FrameError::BadLength(2));
+        assert_eq!(
+            Frame::new_checked(&[0x02, 0x02, 0x00][..], Dialect::St7570).unwrap_err(),
+            FrameError::BadLength(2)
+        );
     }
 
     #[test]
@@ -263,7 +289,17 @@ mod tests {
             FrameError::Truncated { needed: 8 }
         );
         assert!(Frame::new_checked(&[][..], Dialect::St7580).is_err());
-        assert_eq!(LocalFrame { stx: Stx::Repeat, code: 1, data: vec![] }.emit(Dialect::St7570), Err(EmitError::RepeatNotInDialect));
-        assert!(LocalFrame::new(1, vec![0; 256]).emit(Dialect::St7580).is_err());
+        assert_eq!(
+            LocalFrame {
+                stx: Stx::Repeat,
+                code: 1,
+                data: vec![]
+            }
+            .emit(Dialect::St7570),
+            Err(EmitError::RepeatNotInDialect)
+        );
+        assert!(LocalFrame::new(1, vec![0; 256])
+            .emit(Dialect::St7580)
+            .is_err());
     }
 }

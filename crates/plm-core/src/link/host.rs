@@ -101,7 +101,11 @@ pub struct HostConfig {
 
 impl Default for HostConfig {
     fn default() -> Self {
-        HostConfig { timeouts: Timeouts::default(), baud: 57_600, max_attempts: 3 }
+        HostConfig {
+            timeouts: Timeouts::default(),
+            baud: 57_600,
+            max_attempts: 3,
+        }
     }
 }
 
@@ -185,8 +189,15 @@ impl HostEngine {
         let ticket = Ticket(self.next_ticket);
         self.next_ticket = self.next_ticket.wrapping_add(1);
         match frame.emit(self.dialect) {
-            Ok(bytes) => self.queue.push_back(Pending { ticket, bytes, frame, attempts: 0 }),
-            Err(_) => self.events.push_back(Event::Failed(ticket, LinkError::Unencodable)),
+            Ok(bytes) => self.queue.push_back(Pending {
+                ticket,
+                bytes,
+                frame,
+                attempts: 0,
+            }),
+            Err(_) => self
+                .events
+                .push_back(Event::Failed(ticket, LinkError::Unencodable)),
         }
         self.advance(now);
         ticket
@@ -233,7 +244,9 @@ impl HostEngine {
                 self.transmits.push_back(Transmit::TReq { asserted: false });
                 self.attempt_failed(now, LinkError::NoStatus);
             }
-            State::AwaitAck { deadline } if now >= deadline => self.attempt_failed(now, LinkError::NoAck),
+            State::AwaitAck { deadline } if now >= deadline => {
+                self.attempt_failed(now, LinkError::NoAck)
+            }
             _ => {}
         }
         self.advance(now);
@@ -252,7 +265,9 @@ impl HostEngine {
     /// When [`HostEngine::handle_timeout`] must be called next.
     pub fn poll_timeout(&self) -> Option<Instant> {
         let state = match self.state {
-            State::Idle { not_before } if self.current.is_some() || !self.queue.is_empty() => Some(not_before),
+            State::Idle { not_before } if self.current.is_some() || !self.queue.is_empty() => {
+                Some(not_before)
+            }
             State::Idle { .. } => None,
             State::AwaitStatus { deadline } | State::AwaitAck { deadline } => Some(deadline),
         };
@@ -264,14 +279,17 @@ impl HostEngine {
     }
 
     fn send(&mut self, e: Element) {
-        self.transmits.push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
+        self.transmits
+            .push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
         self.events.push_back(Event::Sent(e));
     }
 
     fn on_element(&mut self, now: Instant, e: Element) {
         self.events.push_back(Event::Received(e.clone()));
         match e {
-            Element::Frame { frame, checksum_ok, .. } => {
+            Element::Frame {
+                frame, checksum_ok, ..
+            } => {
                 if !checksum_ok {
                     self.last_accepted = None;
                     self.send(Element::Nak);
@@ -281,10 +299,9 @@ impl HostEngine {
                 self.send(Element::Ack);
                 let window = 2 * self.config.timeouts.t_ack + self.wire(frame.data.len() + 5);
                 let repeat = frame.stx == Stx::Repeat
-                    && self
-                        .last_accepted
-                        .as_ref()
-                        .is_some_and(|(f, at)| f.code == frame.code && f.data == frame.data && now <= at + window);
+                    && self.last_accepted.as_ref().is_some_and(|(f, at)| {
+                        f.code == frame.code && f.data == frame.data && now <= at + window
+                    });
                 if repeat {
                     self.last_accepted = None;
                     self.events.push_back(Event::Repeat(frame));
@@ -328,32 +345,44 @@ impl HostEngine {
         let Some(p) = &self.current else { return };
         let bytes = p.bytes.clone();
         let frame = p.frame.clone();
-        self.transmits.push_back(Transmit::Bytes(bytes[..1].to_vec()));
+        self.transmits
+            .push_back(Transmit::Bytes(bytes[..1].to_vec()));
         self.transmits.push_back(Transmit::TReq { asserted: false });
-        self.transmits.push_back(Transmit::Bytes(bytes[1..].to_vec()));
+        self.transmits
+            .push_back(Transmit::Bytes(bytes[1..].to_vec()));
         self.events.push_back(Event::Sent(Element::Frame {
             checksum: super::checksum(&bytes[1..bytes.len() - 2]),
             frame,
             checksum_ok: true,
         }));
-        self.state = State::AwaitAck { deadline: now + self.wire(bytes.len()) + self.config.timeouts.t_ack };
+        self.state = State::AwaitAck {
+            deadline: now + self.wire(bytes.len()) + self.config.timeouts.t_ack,
+        };
     }
 
     fn attempt_failed(&mut self, now: Instant, cause: LinkError) {
         // A restart is a new T_REQ falling edge: leave T_REQ high for T_IC
         // so that the modem sees the edge.
-        self.state = State::Idle { not_before: now + self.config.timeouts.t_ic };
+        self.state = State::Idle {
+            not_before: now + self.config.timeouts.t_ic,
+        };
         let Some(p) = self.current.take() else { return };
         if p.attempts >= self.config.max_attempts {
             self.events.push_back(Event::Failed(p.ticket, cause));
         } else {
-            self.events.push_back(Event::Retry { ticket: p.ticket, attempt: p.attempts, cause });
+            self.events.push_back(Event::Retry {
+                ticket: p.ticket,
+                attempt: p.attempts,
+                cause,
+            });
             self.current = Some(p);
         }
     }
 
     fn advance(&mut self, now: Instant) {
-        let State::Idle { not_before } = self.state else { return };
+        let State::Idle { not_before } = self.state else {
+            return;
+        };
         if now < not_before {
             return;
         }
@@ -363,6 +392,8 @@ impl HostEngine {
         let Some(p) = &mut self.current else { return };
         p.attempts += 1;
         self.transmits.push_back(Transmit::TReq { asserted: true });
-        self.state = State::AwaitStatus { deadline: now + self.config.timeouts.t_sr };
+        self.state = State::AwaitStatus {
+            deadline: now + self.config.timeouts.t_sr,
+        };
     }
 }

@@ -2,7 +2,10 @@
 //! ACK/NAK and status messages, and applies T_IC (UM0932 3.2.6): after a
 //! pause longer than T_IC inside an element, the bytes so far are dropped.
 
-use super::{Dialect, Element, Frame, FrameError, GarbageReason, Source, StatusMessage, ACK, NAK, STATUS_FIRST};
+use super::{
+    Dialect, Element, Frame, FrameError, GarbageReason, Source, StatusMessage, ACK, NAK,
+    STATUS_FIRST,
+};
 use crate::time::{Duration, Instant};
 use alloc::vec::Vec;
 
@@ -25,7 +28,13 @@ pub(crate) struct Receiver {
 
 impl Receiver {
     pub(crate) fn new(dialect: Dialect, peer: Source) -> Self {
-        Receiver { dialect, peer, buf: Vec::new(), partial: Partial::None, last_byte_at: 0 }
+        Receiver {
+            dialect,
+            peer,
+            buf: Vec::new(),
+            partial: Partial::None,
+            last_byte_at: 0,
+        }
     }
 
     /// Whether a frame or status message is being received.
@@ -51,7 +60,10 @@ impl Receiver {
             _ => GarbageReason::Truncated,
         };
         if !self.buf.is_empty() {
-            out.push(Element::Garbage { bytes: core::mem::take(&mut self.buf), reason });
+            out.push(Element::Garbage {
+                bytes: core::mem::take(&mut self.buf),
+                reason,
+            });
         }
         self.partial = Partial::None;
     }
@@ -81,7 +93,10 @@ impl Receiver {
             Partial::Status => {
                 self.buf.push(byte);
                 if self.buf.len() == self.dialect.status_len() {
-                    out.push(Element::Status(StatusMessage::new(self.dialect, &self.buf[1..])));
+                    out.push(Element::Status(StatusMessage::new(
+                        self.dialect,
+                        &self.buf[1..],
+                    )));
                     self.buf.clear();
                     self.partial = Partial::None;
                 }
@@ -104,7 +119,11 @@ impl Receiver {
                     Some(next) => {
                         self.flush(out);
                         match next {
-                            Partial::None => out.push(if byte == ACK { Element::Ack } else { Element::Nak }),
+                            Partial::None => out.push(if byte == ACK {
+                                Element::Ack
+                            } else {
+                                Element::Nak
+                            }),
                             p => {
                                 self.partial = p;
                                 self.buf.push(byte);

@@ -8,7 +8,10 @@
 //! that frame are garbage. The same rule guards multi-byte status messages.
 //! The result does not depend on how the input is chunked.
 
-use super::{Dialect, Element, Frame, FrameError, GarbageReason, Source, StatusMessage, ACK, NAK, STATUS_FIRST};
+use super::{
+    Dialect, Element, Frame, FrameError, GarbageReason, Source, StatusMessage, ACK, NAK,
+    STATUS_FIRST,
+};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
@@ -148,7 +151,11 @@ impl StreamDecoder {
                         Err(()) => return,
                     },
                     Probe::NeedMore => return,
-                    Probe::No if self.finished && Frame::new_checked(&self.buf[p..], self.dialect).is_err_and(|e| matches!(e, FrameError::Truncated { .. })) => {
+                    Probe::No
+                        if self.finished
+                            && Frame::new_checked(&self.buf[p..], self.dialect)
+                                .is_err_and(|e| matches!(e, FrameError::Truncated { .. })) =>
+                    {
                         // A frame cut off by the end of the input: report
                         // it whole as truncated, unless a frame hides in it.
                         match self.valid_frame_within(p + 1, self.buf.len()) {
@@ -216,7 +223,9 @@ mod tests {
     use alloc::vec;
 
     fn ping() -> Vec<u8> {
-        LocalFrame::new(0x2C, vec![1, 2, 3]).emit(Dialect::St7580).unwrap()
+        LocalFrame::new(0x2C, vec![1, 2, 3])
+            .emit(Dialect::St7580)
+            .unwrap()
     }
 
     #[test]
@@ -227,13 +236,25 @@ mod tests {
         let els = StreamDecoder::decode_all(Dialect::St7580, Source::Modem, &bytes);
         let kinds: Vec<_> = els.iter().map(Element::kind).collect();
         assert_eq!(kinds, ["status", "ack", "frame", "nak", "garbage"]);
-        assert_eq!(els[4], Element::Garbage { bytes: vec![0xAA, 0xBB], reason: GarbageReason::Unexpected });
+        assert_eq!(
+            els[4],
+            Element::Garbage {
+                bytes: vec![0xAA, 0xBB],
+                reason: GarbageReason::Unexpected
+            }
+        );
     }
 
     #[test]
     fn host_side_never_sends_status() {
         let els = StreamDecoder::decode_all(Dialect::St7580, Source::Host, &[0x3F, 0x08]);
-        assert_eq!(els, vec![Element::Garbage { bytes: vec![0x3F, 0x08], reason: GarbageReason::Unexpected }]);
+        assert_eq!(
+            els,
+            vec![Element::Garbage {
+                bytes: vec![0x3F, 0x08],
+                reason: GarbageReason::Unexpected
+            }]
+        );
     }
 
     #[test]
@@ -243,7 +264,13 @@ mod tests {
         f[last] ^= 0xFF;
         let els = StreamDecoder::decode_all(Dialect::St7580, Source::Any, &f);
         assert_eq!(els.len(), 1);
-        assert!(matches!(els[0], Element::Frame { checksum_ok: false, .. }));
+        assert!(matches!(
+            els[0],
+            Element::Frame {
+                checksum_ok: false,
+                ..
+            }
+        ));
     }
 
     #[test]
@@ -255,14 +282,22 @@ mod tests {
         bytes.extend(vec![0u8; 300]);
         let els = StreamDecoder::decode_all(Dialect::St7580, Source::Any, &bytes);
         assert!(matches!(&els[0], Element::Garbage { bytes, .. } if bytes == &[0x02, 0xFF]));
-        assert!(matches!(&els[1], Element::Frame { checksum_ok: true, frame, .. } if frame.code == 0x2C));
+        assert!(
+            matches!(&els[1], Element::Frame { checksum_ok: true, frame, .. } if frame.code == 0x2C)
+        );
     }
 
     #[test]
     fn truncated_frame_at_end_of_input() {
         let f = ping();
         let els = StreamDecoder::decode_all(Dialect::St7580, Source::Any, &f[..4]);
-        assert_eq!(els, vec![Element::Garbage { bytes: f[..4].to_vec(), reason: GarbageReason::Truncated }]);
+        assert_eq!(
+            els,
+            vec![Element::Garbage {
+                bytes: f[..4].to_vec(),
+                reason: GarbageReason::Truncated
+            }]
+        );
     }
 
     #[test]

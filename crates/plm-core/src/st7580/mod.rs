@@ -1,1 +1,15 @@
-//! ST7580 commands and MIB (UM0932 3.3, 4).
+//! The ST7580 host interface: every command of UM0932 3.3 and every MIB
+//! object of UM0932 4, typed, with parse, emit and the chip's validation.
+
+pub mod code;
+mod command;
+pub mod fields;
+pub mod mib;
+mod types;
+
+pub use command::{Command, ParseError};
+pub use types::{
+    ActiveLayer, Channel, DataConfirm, DataIndication, DataRequest, ErrorCause, FrequencySet,
+    IndicationInfo, Modulation, ResetCause, ResetData, SsDataRequest, Status, Temperature,
+    TxParams,
+};

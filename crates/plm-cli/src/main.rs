@@ -1,0 +1,116 @@
+//! `plm`: decode ST power line modem host-interface traffic.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use plm_core::decode::Decoder;
+use plm_core::link::{Dialect, Source};
+use std::io::{self, BufWriter, Read, Write};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "plm",
+    version,
+    about = "Tools for ST power line modems (ST7580, ST7570)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Decode host-interface bytes into JSON Lines, one object per frame,
+    /// ACK, NAK, status message or run of garbage.
+    Decode(DecodeArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Chip {
+    St7580,
+    St7570,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum From {
+    /// Bytes the host sent (no status messages).
+    Host,
+    /// Bytes the modem sent.
+    Modem,
+}
+
+#[derive(clap::Args)]
+struct DecodeArgs {
+    /// Which chip's host interface.
+    #[arg(long, value_enum)]
+    chip: Chip,
+    /// Who sent the bytes (default: either).
+    #[arg(long, value_enum)]
+    from: Option<From>,
+    /// Name MIB_ReadConfirm frames as this object (hex or decimal index)
+    /// when the MIB_ReadRequest is not part of the input.
+    #[arg(long, value_parser = parse_index)]
+    mib_index: Option<u8>,
+    /// Hex bytes (spaces, dots, colons allowed); read from stdin if absent.
+    hex: Vec<String>,
+}
+
+fn parse_index(s: &str) -> Result<u8, String> {
+    let t = s.trim_end_matches(['h', 'H']);
+    let t = t.strip_prefix("0x").unwrap_or(t);
+    u8::from_str_radix(
+        t,
+        if t.len() != s.len() || s.starts_with("0x") {
+            16
+        } else {
+            10
+        },
+    )
+    .map_err(|_| format!("'{s}' is not a MIB index (0..255, or hex like 0Ah / 0x0a)"))
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Decode(args) => match decode(args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(msg) => {
+                eprintln!("plm decode: {msg}");
+                ExitCode::from(2)
+            }
+        },
+    }
+}
+
+fn decode(args: DecodeArgs) -> Result<(), String> {
+    let text = if args.hex.is_empty() {
+        let mut s = String::new();
+        io::stdin()
+            .read_to_string(&mut s)
+            .map_err(|e| format!("cannot read stdin: {e}"))?;
+        s
+    } else {
+        args.hex.join(" ")
+    };
+    let bytes = plm_core::hex::parse(&text).map_err(|e| format!("input is not hex: {e}"))?;
+    let dialect = match args.chip {
+        Chip::St7580 => Dialect::St7580,
+        Chip::St7570 => Dialect::St7570,
+    };
+    let source = match args.from {
+        Some(From::Host) => Source::Host,
+        Some(From::Modem) => Source::Modem,
+        None => Source::Any,
+    };
+    let mut decoder = Decoder::new(dialect, source);
+    if let Some(i) = args.mib_index {
+        decoder.assume_mib_read(i);
+    }
+    decoder.push(&bytes);
+    decoder.finish();
+    let mut out = BufWriter::new(io::stdout().lock());
+    while let Some(d) = decoder.next() {
+        let line = serde_json::to_string(&d).map_err(|e| e.to_string())?;
+        writeln!(out, "{line}").map_err(|e| format!("cannot write: {e}"))?;
+    }
+    out.flush().map_err(|e| format!("cannot write: {e}"))
+}
