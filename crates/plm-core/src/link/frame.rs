@@ -265,8 +265,8 @@ mod tests {
     fn checksum_is_sent_lsbyte_first() {
         let data = vec![0xFF; 4];
         let bytes = LocalFrame::new(0x2C, data).emit(Dialect::St7580).unwrap();
-        // 04 + 2C + 4*FF = 0x0430
-        assert_eq!(&bytes[bytes.len() - 2..], &[0x30, 0x04]);
+        // 04 + 2C + 4*FF = 0x042C
+        assert_eq!(&bytes[bytes.len() - 2..], &[0x2C, 0x04]);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Every ST7580 command (UM0932 3.3) as a typed value with parse and emit.
 
 use super::code as c;
-use super::fields::{confirm_data, indication_data};
+use super::fields::{confirm_data, indication_data, tx_options};
 use super::types::{
     DataConfirm, DataIndication, DataRequest, ErrorCause, IndicationInfo, ResetData, SsDataRequest,
     TxParams,
@@ -186,7 +186,17 @@ fn params(code: u8, data: &[u8], extra: usize) -> Result<(TxParams, usize), Pars
         max: 255,
         got: data.len(),
     };
-    let (p, n) = TxParams::parse(data).ok_or(short(1 + extra))?;
+    let Some((p, n)) = TxParams::parse(data) else {
+        // UM0932 Tables 35/45: byte 0 announces 3 TX frequency bytes (bit 0)
+        // and a TX gain byte (bit 3); say how many it needs in all.
+        let needed = data.first().map_or(1, |b| {
+            let o = [*b];
+            let set = |f: &crate::field::Field| f.get(&o) == Some(1);
+            1 + 3 * set(&tx_options::CUSTOM_MIB_FREQUENCY) as usize
+                + set(&tx_options::GAIN_SELECTOR) as usize
+        });
+        return Err(short(needed + extra));
+    };
     if data.len() < n + extra {
         return Err(short(n + extra));
     }

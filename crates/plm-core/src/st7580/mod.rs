@@ -6,6 +6,7 @@ mod command;
 pub mod fields;
 pub mod mib;
 mod types;
+pub mod validate;
 
 pub use command::{Command, ParseError};
 pub use types::{
