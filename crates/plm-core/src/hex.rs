@@ -76,7 +76,7 @@ pub fn parse(text: &str) -> Result<Vec<u8>, HexError> {
                 at: start,
             });
         }
-        if digits.len() % 2 != 0 {
+        if !digits.len().is_multiple_of(2) {
             return Err(HexError::OddDigits { at: start });
         }
         for pair in digits.chunks(2) {
