@@ -105,3 +105,56 @@ fn table_10_to_15_codes_are_all_distinct_and_named() {
     assert_eq!(count(CommandType::Error), 8, "Table 12");
     assert_eq!(count(CommandType::Indication), 6, "Table 15");
 }
+
+/// ST7570 UM sections 8.1 and 9: worked examples with exact bytes. Only the
+/// link layer (length counts command + data + checksum) is checked here;
+/// the ST7570 commands come with their own issue.
+#[test]
+fn st7570_worked_examples_frame_and_checksum() {
+    use plm_core::link::{Element, StreamDecoder};
+    let examples = [
+        // 8.1 CMD_WriteDBRequest, checksum 7E.02h
+        (
+            "02 13 41 A1.00 09 00 10 10.21.01 44.F7.00 00.00.00 02 01 7E.02",
+            0x41,
+            16,
+            0x027E,
+        ),
+        // 8.1 CMD_WriteDBConfirm, checksum 7F.02h
+        (
+            "02 13 42 A1.00 09 00 10 10.21.01 44.F7.00 00.00.00 02 01 7F.02",
+            0x42,
+            16,
+            0x027F,
+        ),
+    ];
+    let mut phy = String::from("02 29 51 ");
+    for b in 0..0x26u8 {
+        phy.push_str(&format!("{b:02x} "));
+    }
+    phy.push_str("39 03"); // 9: CMD_DataRequest, P_SDU 00h..25h, checksum 39.03h
+    let phy_example = (phy.as_str(), 0x51, 38, 0x0339);
+    for (hex, code, data_len, sum) in examples.iter().copied().chain([phy_example]) {
+        let bytes = plm_core::hex::parse(hex).unwrap();
+        let els = StreamDecoder::decode_all(Dialect::St7570, Source::Host, &bytes);
+        assert_eq!(els.len(), 1, "{hex}");
+        let Element::Frame {
+            frame,
+            checksum,
+            checksum_ok,
+        } = &els[0]
+        else {
+            panic!("{hex}: {els:?}")
+        };
+        assert!(checksum_ok, "{hex}");
+        assert_eq!(
+            (frame.code, frame.data.len(), *checksum),
+            (code, data_len, sum)
+        );
+        assert_eq!(
+            frame.emit(Dialect::St7570).unwrap(),
+            bytes,
+            "re-emitted bytes"
+        );
+    }
+}
