@@ -44,10 +44,11 @@ enum State {
     AwaitHostFrame {
         deadline: Instant,
     },
-    /// A frame is out (STX 02h): waiting for ACK until `deadline`, then the
-    /// repeat. `refused` once a NAK or another frame came instead.
+    /// A frame is out (STX 02h), its last byte leaving the UART at `end`:
+    /// waiting for ACK until `deadline`, then the repeat.
     AwaitAck {
         frame: LocalFrame,
+        end: Instant,
         deadline: Instant,
     },
 }
@@ -70,6 +71,11 @@ pub struct DeviceEngine {
     host_frame_open: bool,
     transmits: VecDeque<Transmit>,
     events: VecDeque<DeviceEvent>,
+    /// When the UART will have sent every byte written so far. Timeouts
+    /// run from the end of what they time (UM0932 3.2.7, 3.2.8), and a
+    /// frame written right behind an ACK or a repeat ends later than its
+    /// own length says.
+    tx_idle_at: Instant,
 }
 
 impl DeviceEngine {
@@ -88,6 +94,7 @@ impl DeviceEngine {
             host_frame_open: false,
             transmits: VecDeque::new(),
             events: VecDeque::new(),
+            tx_idle_at: 0,
         }
     }
 
@@ -121,8 +128,13 @@ impl DeviceEngine {
         self.host_frame_open = false;
     }
 
-    /// Queues a frame for the host (confirms, errors, indications).
+    /// Queues a frame for the host (confirms, errors, indications). A frame
+    /// that cannot be emitted (data longer than the dialect allows) is
+    /// dropped: no modem can send it.
     pub fn submit(&mut self, now: Instant, frame: LocalFrame) {
+        if frame.emit(self.dialect).is_err() {
+            return;
+        }
         self.queue.push_back(frame);
         self.advance(now);
     }
@@ -165,9 +177,11 @@ impl DeviceEngine {
         }
         match &self.state {
             State::AwaitHostFrame { deadline } if now > *deadline => self.state = State::Idle,
-            State::AwaitAck { frame, deadline } if now >= *deadline => {
+            State::AwaitAck {
+                frame, deadline, ..
+            } if now >= *deadline => {
                 let frame = frame.clone();
-                self.repeat(frame);
+                self.repeat(now, frame);
             }
             _ => {}
         }
@@ -198,31 +212,49 @@ impl DeviceEngine {
         }
     }
 
-    fn send(&mut self, e: Element) {
-        self.transmits
-            .push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
-        self.events.push_back(DeviceEvent::Sent(e));
+    /// Accounts for `n` bytes written at `now`; returns when the last one
+    /// will have left the UART.
+    fn written(&mut self, now: Instant, n: usize) -> Instant {
+        self.tx_idle_at = self.tx_idle_at.max(now) + wire_time(n, self.baud);
+        self.tx_idle_at
     }
 
-    fn send_frame(&mut self, frame: &LocalFrame) -> usize {
+    /// Sends `e`; returns when its last byte will have left.
+    fn send(&mut self, now: Instant, e: Element) -> Instant {
+        let bytes = e.to_bytes(self.dialect);
+        let end = self.written(now, bytes.len());
+        self.transmits.push_back(Transmit::Bytes(bytes));
+        self.events.push_back(DeviceEvent::Sent(e));
+        end
+    }
+
+    /// Sends `frame`; returns when its last byte will have left.
+    fn send_frame(&mut self, now: Instant, frame: &LocalFrame) -> Instant {
         let bytes = frame.emit(self.dialect).unwrap_or_default();
         let n = bytes.len();
+        let end = self.written(now, n);
         self.events.push_back(DeviceEvent::Sent(Element::Frame {
             frame: frame.clone(),
             checksum: super::checksum(&bytes[1..n.saturating_sub(2)]),
             checksum_ok: true,
         }));
         self.transmits.push_back(Transmit::Bytes(bytes));
-        n
+        end
     }
 
     /// UM0932 3.2.7: repeat once with STX 03h; that one counts as delivered.
-    fn repeat(&mut self, frame: LocalFrame) {
-        let again = LocalFrame {
-            stx: Stx::Repeat,
-            ..frame
+    fn repeat(&mut self, now: Instant, frame: LocalFrame) {
+        // STX 03h exists only in the ST7580 dialect; emitting it in the
+        // ST7570 one fails (and used to panic here). The ST7570 repeats with
+        // the same frame (its UM 5.2.2, after T_WBC and only on NAK: not
+        // modelled, only the ST7580 rules are).
+        let stx = if self.dialect.is_stx(Stx::Repeat.byte()) {
+            Stx::Repeat
+        } else {
+            Stx::First
         };
-        self.send_frame(&again);
+        let again = LocalFrame { stx, ..frame };
+        self.send_frame(now, &again);
         self.state = State::Idle;
         self.events.push_back(DeviceEvent::Delivered {
             frame: LocalFrame {
@@ -233,10 +265,14 @@ impl DeviceEngine {
         });
     }
 
-    fn on_element(&mut self, _now: Instant, e: Element) {
+    fn on_element(&mut self, now: Instant, e: Element) {
         self.events.push_back(DeviceEvent::Received(e.clone()));
         match (&self.state, e) {
-            (State::AwaitAck { frame, .. }, Element::Ack) => {
+            // Only an ACK that comes after the frame's last byte can be the
+            // host's answer to it (UM0932 3.2.3, 3.2.7): an earlier one
+            // answers what was sent before, typically the STX 03h repeat
+            // of the previous frame, written right before this one.
+            (State::AwaitAck { frame, end, .. }, Element::Ack) if now > *end => {
                 let frame = frame.clone();
                 self.state = State::Idle;
                 self.events.push_back(DeviceEvent::Delivered {
@@ -256,10 +292,10 @@ impl DeviceEngine {
             ) => {
                 self.host_frame_open = false;
                 if checksum_ok {
-                    self.send(Element::Ack);
+                    self.send(now, Element::Ack);
                     self.events.push_back(DeviceEvent::Request(frame));
                 } else {
-                    self.send(Element::Nak);
+                    self.send(now, Element::Nak);
                 }
             }
             (_, Element::Garbage { .. }) => self.host_frame_open = false,
@@ -274,18 +310,18 @@ impl DeviceEngine {
         if self.treq && !self.treq_served {
             self.treq_served = true;
             let status = Element::Status(self.status);
-            let n = self.dialect.status_len();
-            self.send(status);
+            let end = self.send(now, status);
             self.state = State::AwaitHostFrame {
-                deadline: now + wire_time(n, self.baud) + self.timeouts.t_sr,
+                deadline: end + self.timeouts.t_sr,
             };
             return;
         }
         if let Some(frame) = self.queue.pop_front() {
-            let n = self.send_frame(&frame);
+            let end = self.send_frame(now, &frame);
             self.state = State::AwaitAck {
                 frame,
-                deadline: now + wire_time(n, self.baud) + self.timeouts.t_ack,
+                end,
+                deadline: end + self.timeouts.t_ack,
             };
         }
     }

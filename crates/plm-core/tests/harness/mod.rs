@@ -1,0 +1,624 @@
+//! A virtual-time bench for the link engines: a [`HostEngine`] and a
+//! [`DeviceEngine`] joined by a simulated UART, byte by byte.
+//!
+//! Model:
+//! - each direction is a UART transmitter at `baud`, 10 bit times per byte
+//!   (UM0932 3.1); bytes written while the line is busy queue behind the
+//!   ones before, so a byte written at `t` on an idle line arrives at
+//!   `t + wire_time(1)` and a run of back-to-back bytes started at `s`
+//!   has its `k`-th byte arrive at `s + wire_time(k)`, the same arithmetic
+//!   the engines use;
+//! - T_REQ is a wire of its own with no delay, but a level change the host
+//!   asks for after some bytes takes effect once those bytes have left its
+//!   UART (a driver drains its FIFO before touching RTS). So "release
+//!   T_REQ once STX is out" (UM0932 3.2.8) is observable at the device;
+//! - faults are applied per byte at the transmitter: drop (the time still
+//!   passes, the receiver gets nothing), corrupt (XOR), or delay (the line
+//!   stalls before the byte, and the bytes after it wait too);
+//! - the test plays the modem application: an optional responder sees each
+//!   [`DeviceEvent::Request`] and may answer with a frame, submitted to the
+//!   device at that very instant.
+//!
+//! The loop advances time to the earliest of the next byte arrival and the
+//! two engines' `poll_timeout()`, delivers arrivals (before deadlines of
+//! the same instant: a byte exactly T_IC after the previous one is still
+//! in time), calls `handle_timeout` where due, and drains both engines'
+//! transmits and events, recording everything with timestamps.
+
+#![allow(dead_code)]
+
+use plm_core::link::device::{DeviceEngine, DeviceEvent};
+use plm_core::link::host::{Event, HostConfig, HostEngine, Ticket, Transmit};
+use plm_core::link::{Dialect, Element, LocalFrame, ACK, NAK, STATUS_FIRST};
+use plm_core::time::{wire_time, Duration, Instant};
+use std::collections::VecDeque;
+
+/// A direction on the UART.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dir {
+    /// Host TX, modem RX.
+    HostToDev,
+    /// Modem TX, host RX.
+    DevToHost,
+}
+
+/// What a byte is part of, as its sender wrote it (known at the
+/// transmitter, so it is right even when the receiver is confused).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// Byte `offset` (0 = STX) of the `n`-th frame sent this way (0-based).
+    Frame {
+        /// Frame number in this direction.
+        n: usize,
+        /// Offset in the frame.
+        offset: usize,
+    },
+    /// Byte `offset` of the `n`-th status message.
+    Status {
+        /// Status message number.
+        n: usize,
+        /// Offset in the message.
+        offset: usize,
+    },
+    /// An ACK character.
+    Ack,
+    /// A NAK character.
+    Nak,
+    /// Anything else.
+    Other,
+}
+
+impl Part {
+    /// Whether this is byte `offset` of frame `n`.
+    pub fn is_frame_byte(self, n: usize, offset: usize) -> bool {
+        self == Part::Frame { n, offset }
+    }
+
+    /// Whether this is a byte of a status message.
+    pub fn is_status(self) -> bool {
+        matches!(self, Part::Status { .. })
+    }
+}
+
+/// A byte about to be transmitted, shown to the fault injectors.
+#[derive(Debug, Clone, Copy)]
+pub struct ByteCtx {
+    /// Direction.
+    pub dir: Dir,
+    /// Index of the byte among all bytes sent this way.
+    pub index: usize,
+    /// The byte as written.
+    pub byte: u8,
+    /// What it is part of.
+    pub part: Part,
+    /// When it would start on the wire without a fault.
+    pub start: Instant,
+}
+
+/// What happens to a byte.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// Lost: the line time passes, the receiver gets nothing.
+    Drop,
+    /// Received XORed with the mask.
+    Corrupt(u8),
+    /// The line stalls this long before the byte.
+    Delay(Duration),
+}
+
+type Pred = Box<dyn FnMut(&ByteCtx) -> Option<Fault>>;
+
+struct Injector {
+    pred: Pred,
+    /// How many more times it may fire (`None`: always).
+    remaining: Option<usize>,
+}
+
+/// One byte on the wire, for assertions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WireByte {
+    /// Direction.
+    pub dir: Dir,
+    /// Index among all bytes sent this way.
+    pub index: usize,
+    /// What it is part of.
+    pub part: Part,
+    /// The byte as written.
+    pub sent: u8,
+    /// The byte as received, `None` if dropped.
+    pub got: Option<u8>,
+    /// Start bit on the wire.
+    pub start: Instant,
+    /// Stop bit done: when the receiver has it.
+    pub at: Instant,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Item {
+    Byte { at: Instant, byte: u8 },
+    TReq { at: Instant, asserted: bool },
+}
+
+impl Item {
+    fn at(&self) -> Instant {
+        match *self {
+            Item::Byte { at, .. } | Item::TReq { at, .. } => at,
+        }
+    }
+}
+
+/// Tracks which element each written byte belongs to.
+#[derive(Debug, Default)]
+struct Framer {
+    frames: usize,
+    statuses: usize,
+    /// (is_frame, number, next offset, total length if known)
+    cur: Option<(bool, usize, usize, Option<usize>)>,
+}
+
+impl Framer {
+    fn classify(&mut self, dir: Dir, byte: u8, write_start: bool) -> Part {
+        if let Some((is_frame, n, offset, total)) = self.cur {
+            let total = if is_frame && offset == 1 {
+                Some(byte as usize + 5)
+            } else {
+                total
+            };
+            let done = total.is_some_and(|t| offset + 1 >= t);
+            self.cur = (!done).then_some((is_frame, n, offset + 1, total));
+            return if is_frame {
+                Part::Frame { n, offset }
+            } else {
+                Part::Status { n, offset }
+            };
+        }
+        if write_start && (byte == 0x02 || byte == 0x03) {
+            let n = self.frames;
+            self.frames += 1;
+            self.cur = Some((true, n, 1, None));
+            return Part::Frame { n, offset: 0 };
+        }
+        if write_start && byte == STATUS_FIRST && dir == Dir::DevToHost {
+            let n = self.statuses;
+            self.statuses += 1;
+            self.cur = Some((false, n, 1, Some(Dialect::St7580.status_len())));
+            return Part::Status { n, offset: 0 };
+        }
+        match byte {
+            ACK => Part::Ack,
+            NAK => Part::Nak,
+            _ => Part::Other,
+        }
+    }
+}
+
+struct Line {
+    dir: Dir,
+    baud: u32,
+    inflight: VecDeque<Item>,
+    /// When the last byte written so far has left.
+    free_at: Instant,
+    run_start: Instant,
+    run_len: usize,
+    index: usize,
+    framer: Framer,
+    injectors: Vec<Injector>,
+}
+
+impl Line {
+    fn new(dir: Dir, baud: u32) -> Self {
+        Line {
+            dir,
+            baud,
+            inflight: VecDeque::new(),
+            free_at: 0,
+            run_start: 0,
+            run_len: 0,
+            index: 0,
+            framer: Framer::default(),
+            injectors: Vec::new(),
+        }
+    }
+
+    fn fault(&mut self, ctx: &ByteCtx) -> Option<Fault> {
+        for inj in &mut self.injectors {
+            if inj.remaining == Some(0) {
+                continue;
+            }
+            if let Some(f) = (inj.pred)(ctx) {
+                if let Some(r) = &mut inj.remaining {
+                    *r -= 1;
+                }
+                return Some(f);
+            }
+        }
+        None
+    }
+
+    fn write(&mut self, now: Instant, bytes: &[u8], log: &mut Vec<WireByte>) {
+        for (i, &byte) in bytes.iter().enumerate() {
+            let part = self.framer.classify(self.dir, byte, i == 0);
+            let mut start = now.max(self.free_at);
+            let ctx = ByteCtx {
+                dir: self.dir,
+                index: self.index,
+                byte,
+                part,
+                start,
+            };
+            let fault = self.fault(&ctx);
+            if let Some(Fault::Delay(d)) = fault {
+                start += d;
+            }
+            if start > self.free_at || self.run_len == 0 {
+                self.run_start = start;
+                self.run_len = 0;
+            }
+            self.run_len += 1;
+            let at = self.run_start + wire_time(self.run_len, self.baud);
+            self.free_at = at;
+            let got = match fault {
+                Some(Fault::Drop) => None,
+                Some(Fault::Corrupt(mask)) => Some(byte ^ mask),
+                _ => Some(byte),
+            };
+            log.push(WireByte {
+                dir: self.dir,
+                index: self.index,
+                part,
+                sent: byte,
+                got,
+                start,
+                at,
+            });
+            if let Some(b) = got {
+                self.inflight.push_back(Item::Byte { at, byte: b });
+            }
+            self.index += 1;
+        }
+    }
+
+    fn treq(&mut self, now: Instant, asserted: bool) -> Instant {
+        let at = now.max(self.free_at);
+        self.inflight.push_back(Item::TReq { at, asserted });
+        at
+    }
+
+    fn next_at(&self) -> Option<Instant> {
+        self.inflight.front().map(Item::at)
+    }
+
+    fn pop_due(&mut self, now: Instant) -> Option<Item> {
+        if self.next_at()? <= now {
+            self.inflight.pop_front()
+        } else {
+            None
+        }
+    }
+}
+
+type Responder = Box<dyn FnMut(Instant, &LocalFrame) -> Option<LocalFrame>>;
+
+/// The bench.
+pub struct Sim {
+    /// Virtual time (µs).
+    pub now: Instant,
+    /// Baud rate of both directions.
+    pub baud: u32,
+    /// The host engine under test.
+    pub host: HostEngine,
+    /// The device engine under test.
+    pub dev: DeviceEngine,
+    h2d: Line,
+    d2h: Line,
+    responder: Option<Responder>,
+    /// Host events with the time they were polled.
+    pub host_events: Vec<(Instant, Event)>,
+    /// Device events with the time they were polled.
+    pub dev_events: Vec<(Instant, DeviceEvent)>,
+    /// Host transmits, in the order the host asked for them.
+    pub host_tx: Vec<(Instant, Transmit)>,
+    /// Every byte put on the wire, both ways, in write order per direction.
+    pub wire: Vec<WireByte>,
+    /// T_REQ levels as the device saw them (`true`: asserted).
+    pub treq: Vec<(Instant, bool)>,
+    /// Safety net: the loop stops (and panics) after this virtual time.
+    pub horizon: Instant,
+}
+
+/// The ping the tests use (PingRequest, UM0932 Table 10).
+pub const PING_REQ: u8 = 0x2C;
+/// Its confirm (PingConfirm).
+pub const PING_CNF: u8 = 0x2D;
+
+/// The modem application for pings: PingConfirm with the request's data.
+pub fn ping_responder() -> Responder {
+    Box::new(|_, f| (f.code == PING_REQ).then(|| LocalFrame::new(PING_CNF, f.data.clone())))
+}
+
+impl Sim {
+    /// A bench at `baud`; the host gets `config` (its baud is overwritten).
+    pub fn new(baud: u32, config: HostConfig) -> Self {
+        let config = HostConfig { baud, ..config };
+        Sim {
+            now: 0,
+            baud,
+            host: HostEngine::new(Dialect::St7580, config),
+            dev: DeviceEngine::new(Dialect::St7580, baud),
+            h2d: Line::new(Dir::HostToDev, baud),
+            d2h: Line::new(Dir::DevToHost, baud),
+            responder: None,
+            host_events: Vec::new(),
+            dev_events: Vec::new(),
+            host_tx: Vec::new(),
+            wire: Vec::new(),
+            treq: Vec::new(),
+            horizon: 3_600_000_000,
+        }
+    }
+
+    /// A bench at `baud` with the default host settings.
+    pub fn with_baud(baud: u32) -> Self {
+        Sim::new(baud, HostConfig::default())
+    }
+
+    /// Lets `responder` answer the device's requests.
+    pub fn responder(mut self, responder: Responder) -> Self {
+        self.responder = Some(responder);
+        self
+    }
+
+    /// Applies `fault` to the bytes going `dir` that match `pred`, at most
+    /// `times` times (`None`: every time).
+    pub fn inject(
+        &mut self,
+        dir: Dir,
+        times: Option<usize>,
+        fault: Fault,
+        mut pred: impl FnMut(&ByteCtx) -> bool + 'static,
+    ) {
+        self.inject_with(dir, times, move |c| pred(c).then_some(fault));
+    }
+
+    /// Like [`Sim::inject`] with the fault chosen per byte.
+    pub fn inject_with(
+        &mut self,
+        dir: Dir,
+        times: Option<usize>,
+        pred: impl FnMut(&ByteCtx) -> Option<Fault> + 'static,
+    ) {
+        let line = match dir {
+            Dir::HostToDev => &mut self.h2d,
+            Dir::DevToHost => &mut self.d2h,
+        };
+        line.injectors.push(Injector {
+            pred: Box::new(pred),
+            remaining: times,
+        });
+    }
+
+    /// Submits a frame to the host now.
+    pub fn submit(&mut self, frame: LocalFrame) -> Ticket {
+        let t = self.host.submit(self.now, frame);
+        self.pump();
+        t
+    }
+
+    /// Submits a frame to the device now (an unsolicited indication).
+    pub fn dev_submit(&mut self, frame: LocalFrame) {
+        self.dev.submit(self.now, frame);
+        self.pump();
+    }
+
+    /// Drains both engines until neither has anything to say.
+    fn pump(&mut self) {
+        loop {
+            let mut progress = false;
+            while let Some(tx) = self.host.poll_transmit() {
+                progress = true;
+                self.host_tx.push((self.now, tx.clone()));
+                match tx {
+                    Transmit::Bytes(b) => self.h2d.write(self.now, &b, &mut self.wire),
+                    Transmit::TReq { asserted } => {
+                        self.h2d.treq(self.now, asserted);
+                    }
+                }
+            }
+            while let Some(tx) = self.dev.poll_transmit() {
+                progress = true;
+                match tx {
+                    Transmit::Bytes(b) => self.d2h.write(self.now, &b, &mut self.wire),
+                    Transmit::TReq { .. } => panic!("the device has no T_REQ output"),
+                }
+            }
+            while let Some(e) = self.host.poll_event() {
+                progress = true;
+                self.host_events.push((self.now, e));
+            }
+            let mut replies = Vec::new();
+            while let Some(e) = self.dev.poll_event() {
+                progress = true;
+                if let (DeviceEvent::Request(f), Some(r)) = (&e, &mut self.responder) {
+                    replies.extend(r(self.now, f));
+                }
+                self.dev_events.push((self.now, e));
+            }
+            for r in replies {
+                self.dev.submit(self.now, r);
+            }
+            if !progress {
+                break;
+            }
+        }
+    }
+
+    fn next_time(&self) -> Option<Instant> {
+        [
+            self.d2h.next_at(),
+            self.h2d.next_at(),
+            self.host.poll_timeout(),
+            self.dev.poll_timeout(),
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+    }
+
+    /// Runs everything due up to and including `end`, then sets the clock
+    /// to `end`.
+    pub fn run_until(&mut self, end: Instant) {
+        let mut same_instant = 0u32;
+        self.pump();
+        while let Some(next) = self.next_time() {
+            if next > end {
+                break;
+            }
+            assert!(
+                next <= self.horizon,
+                "still busy at the horizon ({} µs)",
+                self.horizon
+            );
+            // A deadline already past is due now.
+            let t = next.max(self.now);
+            if t == self.now {
+                same_instant += 1;
+                assert!(
+                    same_instant < 10_000,
+                    "no progress at {t} µs: an engine keeps asking for the same instant"
+                );
+            } else {
+                same_instant = 0;
+            }
+            self.now = t;
+            while let Some(item) = self.d2h.pop_due(t) {
+                if let Item::Byte { byte, .. } = item {
+                    self.host.handle_rx(t, &[byte]);
+                }
+                self.pump();
+            }
+            while let Some(item) = self.h2d.pop_due(t) {
+                match item {
+                    Item::Byte { byte, .. } => self.dev.handle_rx(t, &[byte]),
+                    Item::TReq { asserted, .. } => {
+                        self.treq.push((t, asserted));
+                        self.dev.set_treq(t, asserted);
+                    }
+                }
+                self.pump();
+            }
+            if self.host.poll_timeout().is_some_and(|d| d <= t) {
+                self.host.handle_timeout(t);
+                self.pump();
+            }
+            if self.dev.poll_timeout().is_some_and(|d| d <= t) {
+                self.dev.handle_timeout(t);
+                self.pump();
+            }
+        }
+        self.now = self.now.max(end);
+    }
+
+    /// Runs until nothing is in flight and no engine waits for a deadline.
+    pub fn run_to_idle(&mut self) {
+        self.run_until(Instant::MAX);
+        assert_eq!(self.next_time(), None);
+    }
+
+    // ---- queries -------------------------------------------------------
+
+    /// The bytes that went `dir`, in order, with their fate.
+    pub fn wire(&self, dir: Dir) -> impl Iterator<Item = &WireByte> {
+        self.wire.iter().filter(move |w| w.dir == dir)
+    }
+
+    /// The bytes received going `dir` (after faults).
+    pub fn received(&self, dir: Dir) -> Vec<u8> {
+        self.wire(dir).filter_map(|w| w.got).collect()
+    }
+
+    /// The bytes of the `n`-th frame sent `dir`.
+    pub fn frame_bytes(&self, dir: Dir, n: usize) -> Vec<WireByte> {
+        self.wire(dir)
+            .filter(|w| matches!(w.part, Part::Frame { n: m, .. } if m == n))
+            .copied()
+            .collect()
+    }
+
+    /// When the last byte of the `n`-th frame sent `dir` was through.
+    pub fn frame_end(&self, dir: Dir, n: usize) -> Instant {
+        self.frame_bytes(dir, n).last().expect("no such frame").at
+    }
+
+    /// When the first byte of the `n`-th frame sent `dir` started.
+    pub fn frame_start(&self, dir: Dir, n: usize) -> Instant {
+        self.frame_bytes(dir, n)
+            .first()
+            .expect("no such frame")
+            .start
+    }
+
+    /// Host events matching `f`, with their times.
+    pub fn host_events_where(&self, f: impl Fn(&Event) -> bool) -> Vec<(Instant, Event)> {
+        self.host_events
+            .iter()
+            .filter(|(_, e)| f(e))
+            .cloned()
+            .collect()
+    }
+
+    /// Device events matching `f`, with their times.
+    pub fn dev_events_where(
+        &self,
+        f: impl Fn(&DeviceEvent) -> bool,
+    ) -> Vec<(Instant, DeviceEvent)> {
+        self.dev_events
+            .iter()
+            .filter(|(_, e)| f(e))
+            .cloned()
+            .collect()
+    }
+
+    /// The frames the device accepted as requests.
+    pub fn requests(&self) -> Vec<LocalFrame> {
+        self.dev_events
+            .iter()
+            .filter_map(|(_, e)| match e {
+                DeviceEvent::Request(f) => Some(f.clone()),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// The frames the host reported as [`Event::Frame`].
+    pub fn host_frames(&self) -> Vec<LocalFrame> {
+        self.host_events
+            .iter()
+            .filter_map(|(_, e)| match e {
+                Event::Frame(f) => Some(f.clone()),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// The elements the device sent, in order.
+    pub fn dev_sent(&self) -> Vec<(Instant, Element)> {
+        self.dev_events
+            .iter()
+            .filter_map(|(t, e)| match e {
+                DeviceEvent::Sent(el) => Some((*t, el.clone())),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// The elements the device received, in order.
+    pub fn dev_received(&self) -> Vec<(Instant, Element)> {
+        self.dev_events
+            .iter()
+            .filter_map(|(t, e)| match e {
+                DeviceEvent::Received(el) => Some((*t, el.clone())),
+                _ => None,
+            })
+            .collect()
+    }
+}
