@@ -143,6 +143,10 @@ pub struct HostEngine {
     /// repeat (UM0932 3.2.7).
     last_accepted: Option<(LocalFrame, Instant)>,
     last_status: Option<StatusMessage>,
+    /// When the UART will have sent every byte written so far: T_ACK runs
+    /// from the frame's last byte on the wire (UM0932 3.2.8), which is later
+    /// than its own length says when an ACK was written just before it.
+    tx_idle_at: Instant,
 }
 
 impl HostEngine {
@@ -160,6 +164,7 @@ impl HostEngine {
             events: VecDeque::new(),
             last_accepted: None,
             last_status: None,
+            tx_idle_at: 0,
         }
     }
 
@@ -278,9 +283,17 @@ impl HostEngine {
         }
     }
 
-    fn send(&mut self, e: Element) {
-        self.transmits
-            .push_back(Transmit::Bytes(e.to_bytes(self.dialect)));
+    /// Accounts for `n` bytes written at `now`; returns when the last one
+    /// will have left the UART.
+    fn written(&mut self, now: Instant, n: usize) -> Instant {
+        self.tx_idle_at = self.tx_idle_at.max(now) + wire_time(n, self.config.baud);
+        self.tx_idle_at
+    }
+
+    fn send(&mut self, now: Instant, e: Element) {
+        let bytes = e.to_bytes(self.dialect);
+        self.written(now, bytes.len());
+        self.transmits.push_back(Transmit::Bytes(bytes));
         self.events.push_back(Event::Sent(e));
     }
 
@@ -292,11 +305,11 @@ impl HostEngine {
             } => {
                 if !checksum_ok {
                     self.last_accepted = None;
-                    self.send(Element::Nak);
+                    self.send(now, Element::Nak);
                     return;
                 }
                 // The ACK is sent at once, well within T_ACK.
-                self.send(Element::Ack);
+                self.send(now, Element::Ack);
                 let window = 2 * self.config.timeouts.t_ack + self.wire(frame.data.len() + 5);
                 let repeat = frame.stx == Stx::Repeat
                     && self.last_accepted.as_ref().is_some_and(|(f, at)| {
@@ -355,8 +368,9 @@ impl HostEngine {
             frame,
             checksum_ok: true,
         }));
+        let end = self.written(now, bytes.len());
         self.state = State::AwaitAck {
-            deadline: now + self.wire(bytes.len()) + self.config.timeouts.t_ack,
+            deadline: end + self.config.timeouts.t_ack,
         };
     }
 
