@@ -27,3 +27,28 @@ mod tests {
         assert_eq!(wire_time(96, 9600), 100_000);
     }
 }
+
+/// When a UART transmitter will have sent every byte written to it: the
+/// engines count T_ACK and T_SR from the last byte on the wire (UM0932
+/// 3.2.7, 3.2.8), not from the moment the bytes were handed over.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TxClock {
+    idle_at: Instant,
+}
+
+impl TxClock {
+    /// Accounts for `bytes` characters written at `now` at `baud`; returns
+    /// when the last one will have left.
+    pub fn written(&mut self, now: Instant, bytes: usize, baud: u32) -> Instant {
+        self.idle_at = self.idle_at.max(now) + wire_time(bytes, baud);
+        self.idle_at
+    }
+}
+
+/// The earlier of two optional deadlines.
+pub fn earliest(a: Option<Instant>, b: Option<Instant>) -> Option<Instant> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}

@@ -14,7 +14,7 @@
 use super::host::Transmit;
 use super::rx::Receiver;
 use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
-use crate::time::{wire_time, Instant};
+use crate::time::{earliest, Instant, TxClock};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
@@ -75,7 +75,7 @@ pub struct DeviceEngine {
     /// run from the end of what they time (UM0932 3.2.7, 3.2.8), and a
     /// frame written right behind an ACK or a repeat ends later than its
     /// own length says.
-    tx_idle_at: Instant,
+    tx_clock: TxClock,
 }
 
 impl DeviceEngine {
@@ -94,7 +94,7 @@ impl DeviceEngine {
             host_frame_open: false,
             transmits: VecDeque::new(),
             events: VecDeque::new(),
-            tx_idle_at: 0,
+            tx_clock: TxClock::default(),
         }
     }
 
@@ -206,17 +206,13 @@ impl DeviceEngine {
             State::AwaitAck { deadline, .. } => Some(*deadline),
         };
         let rx = self.rx.deadline(self.timeouts.t_ic);
-        match (state, rx) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        earliest(state, rx)
     }
 
     /// Accounts for `n` bytes written at `now`; returns when the last one
     /// will have left the UART.
     fn written(&mut self, now: Instant, n: usize) -> Instant {
-        self.tx_idle_at = self.tx_idle_at.max(now) + wire_time(n, self.baud);
-        self.tx_idle_at
+        self.tx_clock.written(now, n, self.baud)
     }
 
     /// Sends `e`; returns when its last byte will have left.

@@ -17,7 +17,7 @@
 
 use super::rx::Receiver;
 use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
-use crate::time::{wire_time, Duration, Instant};
+use crate::time::{earliest, wire_time, Duration, Instant, TxClock};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
@@ -146,7 +146,7 @@ pub struct HostEngine {
     /// When the UART will have sent every byte written so far: T_ACK runs
     /// from the frame's last byte on the wire (UM0932 3.2.8), which is later
     /// than its own length says when an ACK was written just before it.
-    tx_idle_at: Instant,
+    tx_clock: TxClock,
 }
 
 impl HostEngine {
@@ -164,7 +164,7 @@ impl HostEngine {
             events: VecDeque::new(),
             last_accepted: None,
             last_status: None,
-            tx_idle_at: 0,
+            tx_clock: TxClock::default(),
         }
     }
 
@@ -277,17 +277,13 @@ impl HostEngine {
             State::AwaitStatus { deadline } | State::AwaitAck { deadline } => Some(deadline),
         };
         let rx = self.rx.deadline(self.config.timeouts.t_ic);
-        match (state, rx) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        earliest(state, rx)
     }
 
     /// Accounts for `n` bytes written at `now`; returns when the last one
     /// will have left the UART.
     fn written(&mut self, now: Instant, n: usize) -> Instant {
-        self.tx_idle_at = self.tx_idle_at.max(now) + wire_time(n, self.config.baud);
-        self.tx_idle_at
+        self.tx_clock.written(now, n, self.config.baud)
     }
 
     fn send(&mut self, now: Instant, e: Element) {
