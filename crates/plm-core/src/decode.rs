@@ -163,7 +163,7 @@ impl Decoder {
                         Some(c::name(frame.code).map_or(Json::Null, |n| Json::String(n.into())));
                     let mut fields = Map::new();
                     match Command::parse(frame.code, &frame.data) {
-                        Ok(cmd) => d.error = self.command_fields(&cmd, &mut fields),
+                        Ok(cmd) => d.error = self.command_fields(&cmd, &frame.data, &mut fields),
                         Err(err) => {
                             put_hex(&mut fields, "data", &frame.data);
                             d.error = Some(err.to_string());
@@ -201,7 +201,14 @@ impl Decoder {
 
     /// Fills `f` with the named fields of `cmd`; returns what the modem
     /// would refuse about it, if anything.
-    fn command_fields(&mut self, cmd: &Command, f: &mut Map<String, Json>) -> Option<String> {
+    /// `data` is the frame's data field, from which the layouts read
+    /// directly (nothing is re-encoded).
+    fn command_fields(
+        &mut self,
+        cmd: &Command,
+        data: &[u8],
+        f: &mut Map<String, Json>,
+    ) -> Option<String> {
         use Command::*;
         let mut problem = None;
         match cmd {
@@ -243,28 +250,26 @@ impl Decoder {
                 put_hex(f, "data", data)
             }
             PhyDataRequest(r) | DlDataRequest(r) => {
-                let bytes = cmd.data();
-                put_tx_params(f, &bytes, &r.params);
+                put_tx_params(f, data, &r.params);
                 put_hex(f, "payload", &r.payload);
             }
             SsDataRequest(r) => {
-                let bytes = cmd.data();
-                put_tx_params(f, &bytes, &r.params);
+                put_tx_params(f, data, &r.params);
                 f.insert(
                     tx_options::HEADER_LENGTH.name.into(),
                     Json::from(r.header_length),
                 );
                 put_hex(f, "header_and_payload", &r.header_and_payload);
             }
-            PhyDataConfirm(cf) | DlDataConfirm(cf) | SsDataConfirm(cf) => {
-                put_layout(f, st7580::fields::confirm_data::LAYOUT, &cf.encode())
+            PhyDataConfirm(_) | DlDataConfirm(_) | SsDataConfirm(_) => {
+                put_layout(f, st7580::fields::confirm_data::LAYOUT, data)
             }
             PhyDataIndication(i)
             | DlDataIndication(i)
             | DlSnifferIndication(i)
             | SsDataIndication(i)
             | SsSnifferIndication(i) => {
-                put_layout(f, indication_data::LAYOUT, &i.info.encode());
+                put_layout(f, indication_data::LAYOUT, data);
                 let key = match cmd {
                     PhyDataIndication(_) => "phy_payload",
                     DlDataIndication(_) => "dl_payload",

@@ -229,11 +229,8 @@ impl DeviceEngine {
         let bytes = frame.emit(self.dialect).unwrap_or_default();
         let n = bytes.len();
         let end = self.written(now, n);
-        self.events.push_back(DeviceEvent::Sent(Element::Frame {
-            frame: frame.clone(),
-            checksum: super::checksum(&bytes[1..n.saturating_sub(2)]),
-            checksum_ok: true,
-        }));
+        self.events
+            .push_back(DeviceEvent::Sent(Element::emitted(frame.clone(), &bytes)));
         self.transmits.push_back(Transmit::Bytes(bytes));
         end
     }

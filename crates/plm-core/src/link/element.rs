@@ -104,6 +104,21 @@ impl Element {
         }
     }
 
+    /// The element of a frame this side emitted as `bytes` (its checksum is
+    /// right by construction and is read from the last two bytes).
+    pub fn emitted(frame: LocalFrame, bytes: &[u8]) -> Element {
+        let n = bytes.len();
+        let checksum = match bytes.get(n.saturating_sub(2)..) {
+            Some([lo, hi]) => u16::from_le_bytes([*lo, *hi]),
+            _ => 0,
+        };
+        Element::Frame {
+            frame,
+            checksum,
+            checksum_ok: true,
+        }
+    }
+
     /// The bytes of the element exactly as they were on the wire.
     pub fn to_bytes(&self, dialect: Dialect) -> Vec<u8> {
         match self {

@@ -359,11 +359,8 @@ impl HostEngine {
         self.transmits.push_back(Transmit::TReq { asserted: false });
         self.transmits
             .push_back(Transmit::Bytes(bytes[1..].to_vec()));
-        self.events.push_back(Event::Sent(Element::Frame {
-            checksum: super::checksum(&bytes[1..bytes.len() - 2]),
-            frame,
-            checksum_ok: true,
-        }));
+        self.events
+            .push_back(Event::Sent(Element::emitted(frame, &bytes)));
         let end = self.written(now, bytes.len());
         self.state = State::AwaitAck {
             deadline: end + self.config.timeouts.t_ack,
