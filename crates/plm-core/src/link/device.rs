@@ -108,6 +108,11 @@ impl DeviceEngine {
         self.timeouts = timeouts;
     }
 
+    /// Changes the UART baud rate (the BR0/BR1 pins, read at reset).
+    pub fn set_baud(&mut self, baud: u32) {
+        self.baud = baud;
+    }
+
     /// The bits the next status messages carry.
     pub fn set_status(&mut self, status: StatusMessage) {
         self.status = status;

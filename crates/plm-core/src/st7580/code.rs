@@ -74,3 +74,64 @@ pub fn command_type(code: u8) -> Option<CommandType> {
 pub fn is_request(code: u8) -> bool {
     command_type(code) == Some(CommandType::Request)
 }
+
+/// The confirm that answers `request` when it is accepted (Table 10).
+pub fn confirm_for(request: u8) -> Option<u8> {
+    Some(match request {
+        BIO_RESET_REQUEST => BIO_RESET_CONFIRM,
+        MIB_WRITE_REQUEST => MIB_WRITE_CONFIRM,
+        MIB_READ_REQUEST => MIB_READ_CONFIRM,
+        MIB_ERASE_REQUEST => MIB_ERASE_CONFIRM,
+        PING_REQUEST => PING_CONFIRM,
+        PHY_DATA_REQUEST => PHY_DATA_CONFIRM,
+        DL_DATA_REQUEST => DL_DATA_CONFIRM,
+        SS_DATA_REQUEST => SS_DATA_CONFIRM,
+        _ => return None,
+    })
+}
+
+/// Whether `answer` is what the modem sends back for `request`: its
+/// confirm, its error, or CMD_SyntaxError (UM0932 3.3.23).
+pub fn answers(request: u8, answer: u8) -> bool {
+    answer == CMD_SYNTAX_ERROR
+        || confirm_for(request) == Some(answer)
+        || error_for(request) == Some(answer)
+}
+
+/// The error command that refuses `request` (UM0932 Table 12), if it can
+/// be refused: PingRequest cannot.
+pub fn error_for(request: u8) -> Option<u8> {
+    Some(match request {
+        BIO_RESET_REQUEST => BIO_RESET_ERROR,
+        MIB_WRITE_REQUEST => MIB_WRITE_ERROR,
+        MIB_READ_REQUEST => MIB_READ_ERROR,
+        MIB_ERASE_REQUEST => MIB_ERASE_ERROR,
+        PHY_DATA_REQUEST => PHY_DATA_ERROR,
+        DL_DATA_REQUEST => DL_DATA_ERROR,
+        SS_DATA_REQUEST => SS_DATA_ERROR,
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_request_has_a_confirm_and_all_but_ping_an_error() {
+        for &(c, name, t) in ALL {
+            if t != CommandType::Request {
+                assert_eq!(confirm_for(c), None, "{name}");
+                continue;
+            }
+            let confirm = confirm_for(c).expect(name);
+            assert_eq!(command_type(confirm), Some(CommandType::Confirm), "{name}");
+            match error_for(c) {
+                Some(e) => assert_eq!(command_type(e), Some(CommandType::Error), "{name}"),
+                None => assert_eq!(c, PING_REQUEST),
+            }
+            assert!(answers(c, CMD_SYNTAX_ERROR) && answers(c, confirm));
+            assert!(!answers(c, c));
+        }
+    }
+}

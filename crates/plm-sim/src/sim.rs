@@ -1,0 +1,583 @@
+//! The simulation: modems, their UARTs and hosts, and the power line that
+//! joins them, run in virtual time from one event queue and one seeded RNG.
+//!
+//! Node 0's host is outside: the test, the console or `plm sim` writes its
+//! UART bytes and T_REQ through [`Sim::write`] and [`Sim::set_treq`] and
+//! reads what the modem sent with [`Sim::host_read`]. Every other node's
+//! host is an [`EchoHost`] that sends back what its modem hears.
+
+use crate::echo::EchoHost;
+use crate::line::{self, LineConfig, Transmission};
+use crate::modem::{Reception, St7580};
+use crate::rng::Rng;
+use crate::uart::{ByteFaults, OneShot, Wire};
+use plm_core::link::host::Transmit;
+use plm_core::mib::MibError;
+use plm_core::st7580::{Channel, Modulation, ResetCause, Temperature};
+use plm_core::time::{earliest, Duration, Instant};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, VecDeque};
+
+/// How a simulation starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimConfig {
+    /// Seed of the one RNG: the same seed gives the same run.
+    pub seed: u64,
+    /// Modems on the line (at least 1): node 0 is the host's, the others
+    /// echo.
+    pub nodes: usize,
+    /// UART baud rate of every node (UM0932 Table 5).
+    pub baud: u32,
+    /// Conditions on the power line.
+    pub line: LineConfig,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            seed: 1,
+            nodes: 1,
+            baud: 57_600,
+            line: LineConfig::default(),
+        }
+    }
+}
+
+/// A direction on node 0's UART.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dir {
+    /// Host TX to modem RX.
+    HostToModem,
+    /// Modem TX to host RX.
+    ModemToHost,
+}
+
+/// A fault to inject on node 0, at the current time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// Lose the next byte written this way.
+    DropByte(Dir),
+    /// Flip bits (the mask) of the next byte written this way.
+    CorruptByte(Dir, u8),
+    /// Stall the line before the next byte written this way.
+    DelayByte(Dir, Duration),
+    /// Pull RESETN: the modem restarts with its factory MIB (Table 19
+    /// cause 0).
+    ModemReset,
+    /// The watchdog fires: the modem restarts and keeps the MIB objects
+    /// 00h-02h the host wrote (Table 19 cause 1).
+    Watchdog,
+    /// Pull the cable: nothing crosses the UART, T_REQ floats high.
+    Unplug,
+    /// Plug it back in.
+    Plug,
+    /// Set the modem's temperature class (Table 8).
+    Temperature(Temperature),
+}
+
+/// Something that happened on the power line, for traces and views.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LineEvent {
+    /// A modem started a frame.
+    Sent {
+        /// When the preamble started.
+        at: Instant,
+        /// Sender.
+        from: usize,
+        /// Modulation.
+        modulation: Modulation,
+        /// Carrier, Hz.
+        frequency: u32,
+        /// PSDU bytes (length byte included).
+        bytes: usize,
+        /// Airtime.
+        airtime: Duration,
+    },
+    /// A modem received it.
+    Heard {
+        /// End of the frame.
+        at: Instant,
+        /// Sender.
+        from: usize,
+        /// Receiver.
+        to: usize,
+        /// Signal to noise ratio, dB.
+        snr_db: f64,
+        /// Whether a byte was corrupted on the way.
+        corrupted: bool,
+    },
+    /// A modem that could have heard it did not.
+    Missed {
+        /// When it was lost.
+        at: Instant,
+        /// Sender.
+        from: usize,
+        /// Receiver.
+        to: usize,
+        /// Why.
+        why: &'static str,
+    },
+}
+
+/// Line events kept for [`Sim::poll_line_event`].
+const LINE_LOG: usize = 4_096;
+
+#[derive(Debug, Clone)]
+enum Ev {
+    ToModem { node: usize, byte: u8 },
+    ToHost { node: usize, byte: u8 },
+    Treq { node: usize, asserted: bool },
+    TxStart(Box<Transmission>),
+    RxEnd { node: usize, id: u64 },
+}
+
+#[derive(Debug, Clone)]
+struct Scheduled {
+    at: Instant,
+    seq: u64,
+    ev: Ev,
+}
+
+impl PartialEq for Scheduled {
+    fn eq(&self, o: &Self) -> bool {
+        (self.at, self.seq) == (o.at, o.seq)
+    }
+}
+impl Eq for Scheduled {}
+impl PartialOrd for Scheduled {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Scheduled {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        (self.at, self.seq).cmp(&(o.at, o.seq))
+    }
+}
+
+/// A frame being received by one modem.
+#[derive(Debug, Clone)]
+struct ActiveRx {
+    id: u64,
+    tx: Transmission,
+    channel: Channel,
+    snr_db: f64,
+    level: f64,
+    collided: bool,
+}
+
+#[derive(Debug, Clone)]
+struct Node {
+    modem: St7580,
+    /// Host to modem.
+    down: Wire,
+    /// Modem to host.
+    up: Wire,
+    app: Option<EchoHost>,
+    rx: Vec<ActiveRx>,
+}
+
+/// The simulated modems and their power line.
+#[derive(Debug, Clone)]
+pub struct Sim {
+    now: Instant,
+    seq: u64,
+    rng: Rng,
+    line: LineConfig,
+    nodes: Vec<Node>,
+    queue: BinaryHeap<Reverse<Scheduled>>,
+    host_rx: VecDeque<(Instant, u8)>,
+    plugged: bool,
+    treq: bool,
+    log: VecDeque<LineEvent>,
+}
+
+impl Sim {
+    /// Powers every modem on at time 0.
+    pub fn new(config: SimConfig) -> Sim {
+        let nodes = (0..config.nodes.max(1))
+            .map(|i| Node {
+                modem: St7580::new(i, config.baud, 0, config.seed),
+                down: Wire::new(config.baud),
+                up: Wire::new(config.baud),
+                app: (i > 0).then(|| EchoHost::new(config.baud)),
+                rx: Vec::new(),
+            })
+            .collect();
+        Sim {
+            now: 0,
+            seq: 0,
+            rng: Rng::new(config.seed),
+            line: config.line,
+            nodes,
+            queue: BinaryHeap::new(),
+            host_rx: VecDeque::new(),
+            plugged: true,
+            treq: false,
+            log: VecDeque::new(),
+        }
+    }
+
+    /// Virtual time now, µs.
+    pub fn now(&self) -> Instant {
+        self.now
+    }
+
+    /// Number of modems.
+    pub fn nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The modem of `node`.
+    pub fn modem(&self, node: usize) -> &St7580 {
+        &self.nodes[node].modem
+    }
+
+    /// Data indications the host of `node` has echoed (0 for node 0).
+    pub fn echoed(&self, node: usize) -> u64 {
+        self.nodes[node].app.as_ref().map_or(0, |a| a.echoed)
+    }
+
+    /// Configures a MIB object of `node` directly, as its host would have
+    /// (peers come up configured this way). Checked like a write.
+    pub fn configure(&mut self, node: usize, index: u8, data: &[u8]) -> Result<(), MibError> {
+        self.nodes[node].modem.configure(index, data)
+    }
+
+    /// Line conditions.
+    pub fn line(&self) -> &LineConfig {
+        &self.line
+    }
+
+    /// Changes the line conditions from now on.
+    pub fn set_line(&mut self, line: LineConfig) {
+        self.line = line;
+    }
+
+    /// Random byte faults on one direction of node 0's UART.
+    pub fn set_byte_faults(&mut self, dir: Dir, faults: ByteFaults) {
+        self.wire(dir).faults = faults;
+    }
+
+    /// Injects a fault now.
+    pub fn inject(&mut self, fault: Fault) {
+        let now = self.now;
+        match fault {
+            Fault::DropByte(d) => self.wire(d).inject(OneShot::Drop),
+            Fault::CorruptByte(d, m) => self.wire(d).inject(OneShot::Corrupt(m)),
+            Fault::DelayByte(d, by) => self.wire(d).inject(OneShot::Delay(by)),
+            Fault::ModemReset => self.nodes[0].modem.reset(now, ResetCause::PowerOn),
+            Fault::Watchdog => self.nodes[0].modem.reset(now, ResetCause::Watchdog),
+            Fault::Unplug => {
+                self.plugged = false;
+                self.nodes[0].modem.set_treq(now, false);
+            }
+            Fault::Plug => {
+                self.plugged = true;
+                let treq = self.treq;
+                self.nodes[0].modem.set_treq(now, treq);
+            }
+            Fault::Temperature(t) => self.nodes[0].modem.temperature = t,
+        }
+        self.flush();
+    }
+
+    /// Whether node 0's cable is plugged in.
+    pub fn plugged(&self) -> bool {
+        self.plugged
+    }
+
+    /// Node 0's UART baud rate.
+    pub fn baud(&self) -> u32 {
+        self.nodes[0].down.baud()
+    }
+
+    /// Sets node 0's UART baud rate, both ways and at the modem (its
+    /// BR0/BR1 pins strapped to match the host, see protocol notes).
+    pub fn set_baud(&mut self, baud: u32) {
+        let n = &mut self.nodes[0];
+        n.down.set_baud(baud);
+        n.up.set_baud(baud);
+        n.modem.set_baud(baud);
+    }
+
+    /// The host writes `bytes` to node 0's UART now.
+    pub fn write(&mut self, bytes: &[u8]) {
+        if !self.plugged {
+            return;
+        }
+        let arrivals = self.nodes[0].down.write(self.now, bytes, &mut self.rng);
+        for (at, byte) in arrivals {
+            self.schedule(at, Ev::ToModem { node: 0, byte });
+        }
+    }
+
+    /// The host sets node 0's T_REQ (`asserted`: low). It changes once the
+    /// bytes written before have left the UART, as a driver drains its
+    /// FIFO before touching RTS.
+    pub fn set_treq(&mut self, asserted: bool) {
+        self.treq = asserted;
+        let at = self.nodes[0].down.drained_at(self.now);
+        self.schedule(at, Ev::Treq { node: 0, asserted });
+    }
+
+    /// Bytes that reached node 0's host by now, with their arrival times.
+    pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
+        self.host_rx.drain(..).collect()
+    }
+
+    /// The next line event, oldest first (the last few thousand are kept).
+    pub fn poll_line_event(&mut self) -> Option<LineEvent> {
+        self.log.pop_front()
+    }
+
+    /// The next moment anything happens.
+    pub fn next_deadline(&self) -> Option<Instant> {
+        let mut d = self.queue.peek().map(|s| s.0.at);
+        for n in &self.nodes {
+            d = earliest(d, n.modem.poll_timeout());
+            d = earliest(d, n.app.as_ref().and_then(|a| a.poll_timeout()));
+        }
+        d
+    }
+
+    /// Runs everything due up to `t`, then sets the clock to `t`.
+    pub fn advance_to(&mut self, t: Instant) {
+        while let Some(d) = self.next_deadline() {
+            if d > t {
+                break;
+            }
+            self.now = self.now.max(d);
+            self.step();
+        }
+        self.now = self.now.max(t);
+    }
+
+    fn wire(&mut self, dir: Dir) -> &mut Wire {
+        let n = &mut self.nodes[0];
+        match dir {
+            Dir::HostToModem => &mut n.down,
+            Dir::ModemToHost => &mut n.up,
+        }
+    }
+
+    fn schedule(&mut self, at: Instant, ev: Ev) {
+        self.seq += 1;
+        self.queue.push(Reverse(Scheduled {
+            at,
+            seq: self.seq,
+            ev,
+        }));
+    }
+
+    fn record(&mut self, e: LineEvent) {
+        if self.log.len() == LINE_LOG {
+            self.log.pop_front();
+        }
+        self.log.push_back(e);
+    }
+
+    /// Everything due now: queued events first (a byte exactly T_IC after
+    /// the previous one is in time), then the components' deadlines.
+    fn step(&mut self) {
+        let now = self.now;
+        while self.queue.peek().is_some_and(|s| s.0.at <= now) {
+            let Reverse(s) = self.queue.pop().expect("peeked");
+            self.dispatch(s.ev);
+            self.flush();
+        }
+        for i in 0..self.nodes.len() {
+            let n = &mut self.nodes[i];
+            if n.modem.poll_timeout().is_some_and(|d| d <= now) {
+                n.modem.handle_timeout(now);
+            }
+            if let Some(app) = n.app.as_mut() {
+                if app.poll_timeout().is_some_and(|d| d <= now) {
+                    app.handle_timeout(now);
+                }
+            }
+        }
+        self.flush();
+    }
+
+    fn dispatch(&mut self, ev: Ev) {
+        let now = self.now;
+        match ev {
+            Ev::ToModem { node, byte } => {
+                if node > 0 || self.plugged {
+                    self.nodes[node].modem.handle_rx(now, &[byte]);
+                }
+            }
+            Ev::ToHost { node, byte } => match self.nodes[node].app.as_mut() {
+                Some(app) => app.handle_rx(now, &[byte]),
+                None if self.plugged => self.host_rx.push_back((now, byte)),
+                None => {}
+            },
+            Ev::Treq { node, asserted } => {
+                if node > 0 || self.plugged {
+                    self.nodes[node].modem.set_treq(now, asserted);
+                }
+            }
+            Ev::TxStart(tx) => self.start_transmission(*tx),
+            Ev::RxEnd { node, id } => self.end_reception(node, id),
+        }
+    }
+
+    /// Moves what the modems and apps produced onto the UARTs and the line.
+    fn flush(&mut self) {
+        let now = self.now;
+        for i in 0..self.nodes.len() {
+            while let Some(bytes) = self.nodes[i].modem.poll_transmit() {
+                let arrivals = self.nodes[i].up.write(now, &bytes, &mut self.rng);
+                for (at, byte) in arrivals {
+                    self.schedule(at, Ev::ToHost { node: i, byte });
+                }
+            }
+            while let Some(tx) = self.nodes[i].modem.poll_line() {
+                self.schedule(tx.start, Ev::TxStart(Box::new(tx)));
+            }
+            while let Some(t) = self.nodes[i].app.as_mut().and_then(|a| a.poll_transmit()) {
+                match t {
+                    Transmit::Bytes(bytes) => {
+                        let arrivals = self.nodes[i].down.write(now, &bytes, &mut self.rng);
+                        for (at, byte) in arrivals {
+                            self.schedule(at, Ev::ToModem { node: i, byte });
+                        }
+                    }
+                    Transmit::TReq { asserted } => {
+                        let at = self.nodes[i].down.drained_at(now);
+                        self.schedule(at, Ev::Treq { node: i, asserted });
+                    }
+                }
+            }
+        }
+    }
+
+    /// A frame starts: every modem that can hear it starts receiving.
+    fn start_transmission(&mut self, tx: Transmission) {
+        let now = self.now;
+        self.record(LineEvent::Sent {
+            at: now,
+            from: tx.from,
+            modulation: tx.modulation,
+            frequency: tx.frequency,
+            bytes: tx.psdu.len(),
+            airtime: tx.end - tx.start,
+        });
+        // A modem that starts sending drops what it was receiving.
+        for rx in &mut self.nodes[tx.from].rx {
+            rx.collided = true;
+        }
+        self.seq += 1;
+        let id = self.seq;
+        for to in 0..self.nodes.len() {
+            if to == tx.from {
+                continue;
+            }
+            let n = &self.nodes[to];
+            let Some(channel) = line::channel_for(&n.modem.phy_config(), &tx) else {
+                continue;
+            };
+            let level = line::tx_level(tx.gain) - self.line.attenuation(tx.from, to);
+            let snr_db = level - self.line.noise_dbuv;
+            let why = if !n.modem.is_on() {
+                Some("receiver restarting")
+            } else if n.modem.transmitting() {
+                Some("receiver transmitting")
+            } else if snr_db < line::required_snr(tx.modulation) {
+                Some("signal too weak")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                self.record(LineEvent::Missed {
+                    at: now,
+                    from: tx.from,
+                    to,
+                    why,
+                });
+                continue;
+            }
+            let n = &mut self.nodes[to];
+            // Two frames on one channel at once: neither survives.
+            let mut collided = false;
+            for other in n.rx.iter_mut().filter(|r| r.channel == channel) {
+                other.collided = true;
+                collided = true;
+            }
+            n.rx.push(ActiveRx {
+                id,
+                tx: tx.clone(),
+                channel,
+                snr_db,
+                level,
+                collided,
+            });
+            n.modem.set_receiving(true);
+            self.schedule(tx.end, Ev::RxEnd { node: to, id });
+        }
+    }
+
+    /// A frame ends at one receiver: lost, corrupted or delivered.
+    fn end_reception(&mut self, to: usize, id: u64) {
+        let now = self.now;
+        let n = &mut self.nodes[to];
+        let Some(pos) = n.rx.iter().position(|r| r.id == id) else {
+            return;
+        };
+        let rx = n.rx.remove(pos);
+        n.modem.set_receiving(false);
+        let from = rx.tx.from;
+        let margin = rx.snr_db - line::required_snr(rx.tx.modulation);
+        let why = if rx.collided {
+            Some("collision")
+        } else if !n.modem.is_on() {
+            Some("receiver restarting")
+        } else if self.rng.chance(self.line.loss) {
+            Some("lost on the line")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            self.record(LineEvent::Missed {
+                at: now,
+                from,
+                to,
+                why,
+            });
+            return;
+        }
+        // Within 3 dB of the modulation's threshold, a frame comes through
+        // with a bit error one time in three (model).
+        let weak = margin < 3.0 && self.rng.chance(1.0 / 3.0);
+        let corrupted = weak || self.rng.chance(self.line.corruption);
+        let mut psdu = rx.tx.psdu.clone();
+        if corrupted && !psdu.is_empty() {
+            let at = self.rng.below(psdu.len() as u64) as usize;
+            psdu[at] ^= 1 << self.rng.below(8);
+        }
+        self.record(LineEvent::Heard {
+            at: now,
+            from,
+            to,
+            snr_db: rx.snr_db,
+            corrupted,
+        });
+        let snr = if rx.tx.modulation == Modulation::BFsk {
+            255
+        } else {
+            rx.snr_db.round().clamp(-128.0, 127.0) as i8 as u8
+        };
+        self.nodes[to].modem.receive(
+            now,
+            Reception {
+                modulation: rx.tx.modulation,
+                channel: rx.channel,
+                pga: line::pga(rx.level),
+                snr,
+                uw_end: rx.tx.uw_end,
+                psdu,
+            },
+        );
+    }
+}
