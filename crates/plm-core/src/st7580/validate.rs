@@ -4,7 +4,7 @@
 //! is sent.
 
 use super::fields::tx_options;
-use super::{mib, Command, ErrorCause, Modulation, TxParams};
+use super::{mib, plc, Command, ErrorCause, Modulation, TxParams};
 use alloc::format;
 use alloc::string::String;
 use core::fmt;
@@ -52,8 +52,9 @@ fn check_params(p: &TxParams) -> Result<(), Refusal> {
 }
 
 /// Checks a request as the chip does. `dl_crc_len` is the DL CRC length in
-/// bytes from MIB 00h (1, 2 or 4): a DL frame's payload plus CRC must fit
-/// the PHY length byte (UM0932 Table 3).
+/// bytes from MIB 00h (1, 2 or 4): a DL frame's payload plus CRC, and an SS
+/// frame's header and payload plus 29 bytes of IV, HL and digest plus CRC,
+/// must fit the PHY length byte (UM0932 Tables 3 and 4).
 pub fn check_request(cmd: &Command, dl_crc_len: usize) -> Result<(), Refusal> {
     match cmd {
         Command::MibWriteRequest { index, data } => mib::check_write(*index, data)
@@ -92,6 +93,16 @@ pub fn check_request(cmd: &Command, dl_crc_len: usize) -> Result<(), Refusal> {
             if total > SS_MAX_BUFFER {
                 return wpl(format!(
                     "header and payload are {total} bytes, more than {SS_MAX_BUFFER}"
+                ));
+            }
+            // The SS_SDU (Table 4) adds IV, HL and digest, and rides in a DL
+            // frame whose CRC must fit the PHY length byte too (Table 3).
+            let frame = total + plc::SS_OVERHEAD + dl_crc_len;
+            if frame > plc::MAX_LENGTH {
+                return wpl(format!(
+                    "header and payload of {total} bytes plus {} bytes of IV, HL and digest and a {dl_crc_len}-byte CRC exceed the {} bytes of a PHY frame",
+                    plc::SS_OVERHEAD,
+                    plc::MAX_LENGTH
                 ));
             }
             if hl > total {
@@ -139,6 +150,23 @@ mod tests {
             header_length: hl,
             header_and_payload: vec![0; len],
         })
+    }
+
+    #[test]
+    fn ss_requests_must_fit_a_dl_frame_with_its_crc() {
+        let wpl = |hl, len, crc| {
+            check_request(&ss(hl, len), crc).map_err(|e| e.cause)
+                == Err(ErrorCause::WrongParameterLength)
+        };
+        // 255 = header and payload + 29 (IV, HL, digest) + CRC.
+        assert!(check_request(&ss(4, 222), 4).is_ok());
+        assert!(wpl(4, 223, 4));
+        assert!(check_request(&ss(4, 224), 2).is_ok());
+        assert!(wpl(4, 225, 2));
+        assert!(check_request(&ss(4, 225), 1).is_ok());
+        assert!(wpl(4, 226, 1), "226 of Table 45 leaves no room for a CRC");
+        let e = check_request(&ss(4, 223), 4).unwrap_err();
+        assert!(e.reason.contains("4-byte CRC"), "{e}");
     }
 
     #[test]
