@@ -37,6 +37,11 @@ impl EchoHost {
         }
     }
 
+    /// Sends a command of this host's own (a peer that talks first).
+    pub fn submit(&mut self, now: Instant, cmd: &Command) {
+        self.engine.submit(now, cmd.to_frame());
+    }
+
     /// Bytes from the modem.
     pub fn handle_rx(&mut self, now: Instant, bytes: &[u8]) {
         self.engine.handle_rx(now, bytes);

@@ -13,7 +13,7 @@ use crate::rng::Rng;
 use crate::uart::{ByteFaults, OneShot, Wire};
 use plm_core::link::host::Transmit;
 use plm_core::mib::MibError;
-use plm_core::st7580::{Channel, Modulation, ResetCause, Temperature};
+use plm_core::st7580::{Channel, Command, Modulation, ResetCause, Temperature};
 use plm_core::time::{earliest, Duration, Instant};
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
@@ -242,6 +242,16 @@ impl Sim {
     /// (peers come up configured this way). Checked like a write.
     pub fn configure(&mut self, node: usize, index: u8, data: &[u8]) -> Result<(), MibError> {
         self.nodes[node].modem.configure(index, data)
+    }
+
+    /// Makes the host of peer `node` (not 0) send `cmd` to its modem now,
+    /// e.g. a data request: peers can talk first, not only echo.
+    pub fn peer_request(&mut self, node: usize, cmd: &Command) {
+        let now = self.now;
+        if let Some(app) = self.nodes.get_mut(node).and_then(|n| n.app.as_mut()) {
+            app.submit(now, cmd);
+        }
+        self.flush();
     }
 
     /// Line conditions.
