@@ -14,22 +14,37 @@ struct Bench {
 
 /// Append new benchmarks here (link latency, command rate, RFU, size...).
 fn benches() -> Vec<Bench> {
-    vec![Bench {
-        name: "decoder throughput (native)",
-        sources: &[
-            "crates/plm-core/examples/bench_decode.rs",
-            "crates/plm-core/examples/bench_decode/main.rs",
-        ],
-        cmd: Cmd::new("cargo").args([
-            "run",
-            "--profile",
-            "bench-native",
-            "-p",
-            "plm-core",
-            "--example",
-            "bench_decode",
-        ]),
-    }]
+    vec![
+        Bench {
+            name: "decoder throughput (native)",
+            sources: &[
+                "crates/plm-core/examples/bench_decode.rs",
+                "crates/plm-core/examples/bench_decode/main.rs",
+            ],
+            cmd: Cmd::new("cargo").args([
+                "run",
+                "--profile",
+                "bench-native",
+                "-p",
+                "plm-core",
+                "--example",
+                "bench_decode",
+            ]),
+        },
+        Bench {
+            name: "simulator speed and MIB-read rate (native)",
+            sources: &["crates/plm-sim/examples/bench_sim.rs"],
+            cmd: Cmd::new("cargo").args([
+                "run",
+                "--profile",
+                "bench-native",
+                "-p",
+                "plm-sim",
+                "--example",
+                "bench_sim",
+            ]),
+        },
+    ]
 }
 
 /// Runs every benchmark; all must exist.
