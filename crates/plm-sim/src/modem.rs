@@ -148,6 +148,9 @@ impl St7580 {
     pub fn configure(&mut self, index: u8, data: &[u8]) -> Result<(), plm_core::mib::MibError> {
         mib::check_write(index, data)?;
         self.store(index, data);
+        if let Some(w) = self.written.get_mut(index as usize) {
+            *w = true;
+        }
         Ok(())
     }
 
@@ -199,9 +202,9 @@ impl St7580 {
         let old = std::mem::take(&mut self.mib);
         self.mib = mib::OBJECTS.iter().map(|o| o.default.to_vec()).collect();
         if keep {
-            for i in 0..3 {
+            for (i, value) in old.into_iter().take(3).enumerate() {
                 if self.written[i] {
-                    self.mib[i] = old[i].clone();
+                    self.mib[i] = value;
                 }
             }
         } else {
@@ -468,10 +471,7 @@ impl St7580 {
                 Some(Command::BioResetConfirm { confirm_data: 0 })
             }
             Command::MibWriteRequest { index, data } => {
-                self.store(index, &data);
-                if index <= 2 {
-                    self.written[index as usize] = true;
-                }
+                self.configure(index, &data).map_err(|e| mib::error_cause(&e))?;
                 Some(Command::MibWriteConfirm)
             }
             Command::MibReadRequest { index } => Some(Command::MibReadConfirm {
