@@ -45,11 +45,13 @@ fn suites() -> Vec<Step> {
         Step::cmd("tests", cargo(&["test", "--workspace", "--all-targets"])),
         Step::cmd("doc tests", cargo(&["test", "--workspace", "--doc"])),
         Step::cmd(
-            "plm-core on wasm32",
+            "plm-core and plm-sim on wasm32",
             cargo(&[
                 "build",
                 "-p",
                 "plm-core",
+                "-p",
+                "plm-sim",
                 "--target",
                 "wasm32-unknown-unknown",
             ]),
