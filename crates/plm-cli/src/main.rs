@@ -1,6 +1,8 @@
-//! `plm`: decode ST power line modem host-interface traffic.
+//! `plm`: decode ST power line modem host-interface traffic, and serve the
+//! simulated modem as a serial port over RFC 2217.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use plm_cli::sim_server;
 use plm_core::decode::Decoder;
 use plm_core::link::{Dialect, Source};
 use std::io::{self, BufWriter, Read, Write};
@@ -22,6 +24,9 @@ enum Command {
     /// Decode host-interface bytes into JSON Lines, one object per frame,
     /// ACK, NAK, status message or run of garbage.
     Decode(DecodeArgs),
+    /// Serve a simulated modem as an RFC 2217 (Telnet COM-PORT-OPTION)
+    /// serial port: RTS drives T_REQ, SET-BAUDRATE the BR pins.
+    Sim(SimArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -54,6 +59,28 @@ struct DecodeArgs {
     hex: Vec<String>,
 }
 
+#[derive(clap::Args)]
+struct SimArgs {
+    /// Which chip to simulate (only the ST7580 so far).
+    #[arg(long, value_enum, default_value = "st7580")]
+    chip: Chip,
+    /// Address to listen on; port 0 picks a free port (the one chosen is
+    /// printed).
+    #[arg(long, default_value = "127.0.0.1:7580")]
+    listen: String,
+    /// Allow a --listen address that is not loopback (the server has no
+    /// authentication).
+    #[arg(long)]
+    allow_remote: bool,
+    /// Modems on the simulated power line: the served one and N-1 others
+    /// that echo what they hear.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64))]
+    nodes: u16,
+    /// Seed of the simulation's random number generator.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
 fn parse_index(s: &str) -> Result<u8, String> {
     let t = s.trim_end_matches(['h', 'H']);
     let t = t.strip_prefix("0x").unwrap_or(t);
@@ -78,7 +105,26 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+        Command::Sim(args) => match sim(args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(msg) => {
+                eprintln!("plm sim: {msg}");
+                ExitCode::from(2)
+            }
+        },
     }
+}
+
+fn sim(args: SimArgs) -> Result<(), String> {
+    if let Chip::St7570 = args.chip {
+        return Err("the ST7570 is not simulated yet; use --chip st7580".into());
+    }
+    sim_server::run(sim_server::Options {
+        listen: args.listen,
+        allow_remote: args.allow_remote,
+        nodes: args.nodes.into(),
+        seed: args.seed,
+    })
 }
 
 fn decode(args: DecodeArgs) -> Result<(), String> {

@@ -471,7 +471,8 @@ impl St7580 {
                 Some(Command::BioResetConfirm { confirm_data: 0 })
             }
             Command::MibWriteRequest { index, data } => {
-                self.configure(index, &data).map_err(|e| mib::error_cause(&e))?;
+                self.configure(index, &data)
+                    .map_err(|e| mib::error_cause(&e))?;
                 Some(Command::MibWriteConfirm)
             }
             Command::MibReadRequest { index } => Some(Command::MibReadConfirm {

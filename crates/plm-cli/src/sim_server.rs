@@ -1,0 +1,239 @@
+//! `plm sim`: the simulated ST7580 served as a serial port over RFC 2217,
+//! so that any host software that speaks it (pyserial's `rfc2217://`,
+//! ser2net clients, the console's own TCP transport) can drive it.
+//!
+//! One thread. The simulator runs in virtual microseconds; this loop maps
+//! wall-clock time since the first client connected onto it, advancing it
+//! at least every millisecond while anything is scheduled, and passes
+//! bytes both ways:
+//!
+//! | client (RFC 2217)                    | simulated modem 0          |
+//! |--------------------------------------|----------------------------|
+//! | data                                 | host UART TX -> modem RX   |
+//! | SET-BAUDRATE 9600/19200/38400/57600  | BR pins (`Sim::set_baud`)  |
+//! | SET-CONTROL RTS ON / OFF             | T_REQ asserted / released  |
+//! | data to the client                   | modem UART TX -> host RX   |
+//!
+//! The modems are powered on (simulated time 0) when the first client
+//! connects, so that it sees the BIO_ResetIndication; later clients find
+//! them running. One client at a time: another one is told so and closed.
+//! When the client goes, T_REQ is released and the simulation goes on.
+
+use crate::rfc2217::{self, Action};
+use plm_sim::{Sim, SimConfig};
+use std::io::{ErrorKind, Read, Write};
+use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Baud rates the BR0/BR1 pins select (UM0932 3.1).
+pub const RATES: &[u32] = &plm_sim::BAUD_RATES;
+
+/// The longest the loop sleeps while the simulator has something scheduled.
+const TICK: Duration = Duration::from_millis(1);
+/// The longest it sleeps when nothing is scheduled (only accepting, Ctrl-C).
+const IDLE: Duration = Duration::from_millis(20);
+
+/// What `plm sim` was asked for.
+pub struct Options {
+    pub listen: String,
+    pub allow_remote: bool,
+    pub nodes: usize,
+    pub seed: u64,
+}
+
+/// Serves until Ctrl-C (or SIGTERM).
+pub fn run(opts: Options) -> Result<(), String> {
+    let listener = bind(&opts.listen, opts.allow_remote)?;
+    let addr = listener.local_addr().map_err(|e| e.to_string())?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))
+        .map_err(|e| format!("cannot catch Ctrl-C: {e}"))?;
+
+    let mut sim = Sim::new(SimConfig {
+        seed: opts.seed,
+        nodes: opts.nodes,
+        ..SimConfig::default()
+    });
+    println!(
+        "plm sim: simulated ST7580 (node 0 of {}, seed {}) as RFC 2217 on {addr} \
+         — connect with e.g. pyserial rfc2217://{addr}",
+        opts.nodes, opts.seed
+    );
+    println!("plm sim: the modems power on when the first client connects; Ctrl-C stops");
+
+    // Wall-clock time of simulated time 0.
+    let mut origin: Option<Instant> = None;
+    let mut client: Option<Client> = None;
+    while !stop.load(Ordering::SeqCst) {
+        match listener.accept() {
+            Ok((stream, peer)) if client.is_some() => refuse(stream, peer),
+            Ok((stream, peer)) => {
+                let start = *origin.get_or_insert_with(Instant::now);
+                advance(&mut sim, start);
+                match Client::open(stream, peer, sim.baud()) {
+                    Ok(c) => {
+                        println!("plm sim: client {peer} connected");
+                        client = Some(c);
+                    }
+                    Err(e) => println!("plm sim: client {peer} lost at once: {e}"),
+                }
+            }
+            Err(e) if e.kind() == ErrorKind::WouldBlock => {}
+            Err(e) => eprintln!("plm sim: accept failed: {e}"),
+        }
+        let Some(start) = origin else {
+            std::thread::sleep(IDLE);
+            continue;
+        };
+
+        advance(&mut sim, start);
+        let out: Vec<u8> = sim.host_read().into_iter().map(|(_, b)| b).collect();
+        let wait = match sim.next_deadline() {
+            Some(t) => Duration::from_micros(t.saturating_sub(sim_now(start))).min(TICK),
+            None => IDLE,
+        }
+        .max(Duration::from_micros(50));
+        let Some(c) = client.as_mut() else {
+            // Nobody on the host side of the UART: the bytes are lost.
+            std::thread::sleep(wait);
+            continue;
+        };
+        let result = c.send(&out).and_then(|()| c.serve(&mut sim, start, wait));
+        if let Err(why) = result {
+            println!("plm sim: client {} disconnected ({why})", c.peer);
+            client = None;
+            advance(&mut sim, start);
+            // The host is gone: T_REQ is released (pulled up).
+            sim.set_treq(false);
+        }
+    }
+    if let Some(c) = client {
+        let _ = c.stream.shutdown(std::net::Shutdown::Both);
+        println!("plm sim: client {} disconnected (stopping)", c.peer);
+    }
+    println!("plm sim: stopped");
+    Ok(())
+}
+
+/// Binds `listen`, refusing anything but loopback unless `allow_remote`:
+/// the simulator has no authentication.
+fn bind(listen: &str, allow_remote: bool) -> Result<TcpListener, String> {
+    let addrs: Vec<SocketAddr> = listen
+        .to_socket_addrs()
+        .map_err(|e| format!("--listen {listen}: {e}"))?
+        .collect();
+    if let Some(remote) = addrs.iter().find(|a| !a.ip().is_loopback()) {
+        if !allow_remote {
+            return Err(format!(
+                "--listen {listen}: {} is not a loopback address; anyone who can reach it \
+                 could drive the simulator. Use 127.0.0.1 or [::1], or add --allow-remote",
+                remote.ip()
+            ));
+        }
+    }
+    let listener =
+        TcpListener::bind(&addrs[..]).map_err(|e| format!("cannot listen on {listen}: {e}"))?;
+    listener
+        .set_nonblocking(true)
+        .map_err(|e| format!("cannot listen on {listen}: {e}"))?;
+    Ok(listener)
+}
+
+/// Simulated time now: microseconds of wall-clock time since `start`.
+fn sim_now(start: Instant) -> plm_core::time::Instant {
+    start.elapsed().as_micros() as u64
+}
+
+fn advance(sim: &mut Sim, start: Instant) {
+    sim.advance_to(sim_now(start));
+}
+
+/// A second client while one is connected: told and closed.
+fn refuse(mut stream: TcpStream, peer: SocketAddr) {
+    println!("plm sim: refused {peer}: a client is already connected");
+    let _ = stream.write_all(b"plm sim: busy: the simulated modem has a client already\r\n");
+    let _ = stream.shutdown(std::net::Shutdown::Both);
+}
+
+/// The connected client.
+struct Client {
+    stream: TcpStream,
+    peer: SocketAddr,
+    telnet: rfc2217::Server,
+    /// Modem bytes held while the client has suspended the flow
+    /// (RFC 2217 FLOWCONTROL-SUSPEND).
+    held: Vec<u8>,
+}
+
+impl Client {
+    fn open(stream: TcpStream, peer: SocketAddr, baud: u32) -> std::io::Result<Client> {
+        stream.set_nonblocking(false)?;
+        // Bytes go out as they come: Nagle's delay would eat T_ACK (40 ms).
+        stream.set_nodelay(true)?;
+        stream.set_write_timeout(Some(Duration::from_secs(5)))?;
+        let mut c = Client {
+            stream,
+            peer,
+            telnet: rfc2217::Server::new("plm sim: simulated ST7580, node 0", baud, RATES),
+            held: Vec::new(),
+        };
+        let greeting = c.telnet.greeting();
+        c.stream.write_all(&greeting)?;
+        Ok(c)
+    }
+
+    /// Sends modem bytes to the client, IAC doubled (RFC 2217 "Data
+    /// transfer": the data stream is Telnet, RFC 854).
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.held.extend_from_slice(bytes);
+        if self.telnet.suspended() || self.held.is_empty() {
+            return Ok(());
+        }
+        let data = rfc2217::escape(&self.held);
+        self.held.clear();
+        self.stream.write_all(&data)
+    }
+
+    /// Waits up to `wait` for bytes from the client and carries them out.
+    fn serve(&mut self, sim: &mut Sim, start: Instant, wait: Duration) -> std::io::Result<()> {
+        self.stream.set_read_timeout(Some(wait))?;
+        let mut buf = [0u8; 4096];
+        let n = match self.stream.read(&mut buf) {
+            Ok(0) => {
+                return Err(std::io::Error::new(
+                    ErrorKind::UnexpectedEof,
+                    "closed by the client",
+                ))
+            }
+            Ok(n) => n,
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                return Ok(())
+            }
+            Err(e) if e.kind() == ErrorKind::Interrupted => return Ok(()),
+            Err(e) => return Err(e),
+        };
+        // The bytes arrived now: bring the modem up to now first.
+        advance(sim, start);
+        let mut reply = Vec::new();
+        for action in self.telnet.receive(&buf[..n], &mut reply) {
+            match action {
+                Action::Write(data) => sim.write(&data),
+                Action::SetBaud(baud) => sim.set_baud(baud),
+                Action::SetRts(on) => sim.set_treq(on),
+                Action::PurgeReceive => {
+                    self.held.clear();
+                    sim.host_read();
+                }
+                // Client data goes to the UART at once: nothing is held.
+                Action::PurgeTransmit => {}
+                Action::Suspend(_) => {}
+            }
+        }
+        self.stream.write_all(&reply)?;
+        // Resuming sends what was held.
+        self.send(&[])
+    }
+}
