@@ -193,7 +193,10 @@ pub struct Sim {
 }
 
 impl Sim {
-    /// Powers every modem on at time 0.
+    /// Powers every modem on at virtual time 0: the BIO_ResetIndications
+    /// follow after the boot time. A real-time driver maps its own clock
+    /// onto virtual time from the moment it creates the simulation (or
+    /// from when its host is there to hear them).
     pub fn new(config: SimConfig) -> Sim {
         let nodes = (0..config.nodes.max(1))
             .map(|i| Node {
@@ -341,7 +344,8 @@ impl Sim {
         self.log.pop_front()
     }
 
-    /// The next moment anything happens.
+    /// The next moment anything happens, byte arrivals at the host
+    /// included: a driver that advances to it never misses a byte.
     pub fn next_deadline(&self) -> Option<Instant> {
         let mut d = self.queue.peek().map(|s| s.0.at);
         for n in &self.nodes {
