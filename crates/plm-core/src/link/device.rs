@@ -158,6 +158,11 @@ impl DeviceEngine {
         let mut out = Vec::new();
         for &b in bytes {
             self.rx.push(now, b, self.timeouts.t_ic, &mut out);
+            // Elements this byte completed first: garbage flushed by the
+            // host's STX must not close the frame that STX opens.
+            for e in out.drain(..) {
+                self.on_element(now, e);
+            }
             // UM0932 3.2.8: the first byte of the frame must arrive
             // within T_SR of the status message.
             if let State::AwaitHostFrame { deadline } = self.state {
@@ -166,9 +171,6 @@ impl DeviceEngine {
                     self.host_frame_open = true;
                 }
             }
-        }
-        for e in out {
-            self.on_element(now, e);
         }
         self.advance(now);
     }
