@@ -45,9 +45,20 @@ pub fn build_dist() -> Result {
 }
 
 /// Trunk, told not to look for its own updates: the machine may have no
-/// network beyond the package registries.
+/// network beyond the package registries. The `wasm-opt` that index.html
+/// asks for (`data-wasm-opt`) is npm's `binaryen`, installed by setup with
+/// the browser test packages: Debian's is too old, and Trunk would
+/// otherwise try to download one.
 fn trunk() -> Cmd {
-    Cmd::new("trunk").env("TRUNK_SKIP_VERSION_CHECK", "true")
+    let tools = root().join("tests/e2e/node_modules/.bin");
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let dirs = std::iter::once(tools).chain(std::env::split_paths(&path));
+    let path = std::env::join_paths(dirs)
+        .map(|p| p.to_string_lossy().into_owned())
+        .unwrap_or_else(|_| path.to_string_lossy().into_owned());
+    Cmd::new("trunk")
+        .env("TRUNK_SKIP_VERSION_CHECK", "true")
+        .env("PATH", &path)
 }
 
 fn require_console() -> Result {

@@ -1,0 +1,174 @@
+//! The root component: the stores, the page's timer that drives the
+//! session, the connection bar and the views.
+
+use crate::stores::{provide_console, use_console};
+use crate::views::connection_bar::ConnectionBar;
+use crate::views::data::DataView;
+use crate::views::diagnostics::DiagnosticsView;
+use crate::views::modem::ModemView;
+use crate::views::simulator::SimulatorView;
+use crate::views::traffic::TrafficView;
+use leptos::prelude::*;
+use std::time::Duration;
+
+/// How often the session catches up with the page's clock. Browsers clamp
+/// timers to about 4 ms; the session steps the link in 1 ms slices anyway.
+const TICK: Duration = Duration::from_millis(4);
+
+/// The views, in the order of the tabs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tab {
+    /// Traffic inspector.
+    Traffic,
+    /// MIB configuration.
+    Modem,
+    /// Data requests and indications.
+    Data,
+    /// Ping, status, reset, counters.
+    Diagnostics,
+    /// The simulated world.
+    Simulator,
+}
+
+impl Tab {
+    /// Every tab.
+    pub const ALL: [Tab; 5] = [
+        Tab::Traffic,
+        Tab::Modem,
+        Tab::Data,
+        Tab::Diagnostics,
+        Tab::Simulator,
+    ];
+
+    /// The tab's name.
+    pub fn label(self) -> &'static str {
+        match self {
+            Tab::Traffic => "Traffic",
+            Tab::Modem => "Modem",
+            Tab::Data => "Data",
+            Tab::Diagnostics => "Diagnostics",
+            Tab::Simulator => "Simulator",
+        }
+    }
+
+    /// The URL fragment that opens it (`#modem`).
+    pub fn slug(self) -> &'static str {
+        match self {
+            Tab::Traffic => "traffic",
+            Tab::Modem => "modem",
+            Tab::Data => "data",
+            Tab::Diagnostics => "diagnostics",
+            Tab::Simulator => "simulator",
+        }
+    }
+
+    fn from_hash(hash: &str) -> Tab {
+        let h = hash.trim_start_matches('#');
+        Tab::ALL
+            .into_iter()
+            .find(|t| t.slug() == h)
+            .unwrap_or(Tab::Traffic)
+    }
+}
+
+fn current_hash() -> String {
+    web_sys::window()
+        .and_then(|w| w.location().hash().ok())
+        .unwrap_or_default()
+}
+
+/// The whole console.
+#[component]
+pub fn App() -> impl IntoView {
+    let console = provide_console();
+    // The simulated modem is there at once, so the page is useful on any
+    // machine (DESIGN.md).
+    console.connect_simulated(1);
+    if let Ok(handle) = set_interval_with_handle(move || console.tick(), TICK) {
+        on_cleanup(move || handle.clear());
+    }
+    let tab = RwSignal::new(Tab::from_hash(&current_hash()));
+    let on_hash = window_event_listener(leptos::ev::hashchange, move |_| {
+        tab.set(Tab::from_hash(&current_hash()));
+    });
+    on_cleanup(move || on_hash.remove());
+
+    view! {
+        <div class="app">
+            <div class="chrome">
+            <header class="top">
+                <h1 class="brand">"PLM Console"</h1>
+                <ConnectionBar/>
+            </header>
+            <nav class="tabs" role="tablist">
+                {Tab::ALL
+                    .into_iter()
+                    .map(|t| {
+                        view! {
+                            <a
+                                role="tab"
+                                class="tab"
+                                href=format!("#{}", t.slug())
+                                id=format!("tab-{}", t.slug())
+                                class:active=move || tab.get() == t
+                                aria-selected=move || (tab.get() == t).to_string()
+                            >
+                                {t.label()}
+                            </a>
+                        }
+                    })
+                    .collect_view()}
+            </nav>
+            </div>
+            <main>
+                <Panel tab=tab which=Tab::Traffic>
+                    <TrafficView/>
+                </Panel>
+                <Panel tab=tab which=Tab::Modem>
+                    <ModemView/>
+                </Panel>
+                <Panel tab=tab which=Tab::Data>
+                    <DataView/>
+                </Panel>
+                <Panel tab=tab which=Tab::Diagnostics>
+                    <DiagnosticsView/>
+                </Panel>
+                <Panel tab=tab which=Tab::Simulator>
+                    <SimulatorView/>
+                </Panel>
+            </main>
+            <LinkProblem/>
+        </div>
+    }
+}
+
+/// One view, kept mounted (its form state survives a change of tab) and
+/// hidden unless its tab is chosen.
+#[component]
+fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
+    view! {
+        <section
+            class="panel"
+            role="tabpanel"
+            id=format!("view-{}", which.slug())
+            hidden=move || tab.get() != which
+        >
+            {children()}
+        </section>
+    }
+}
+
+/// The last link problem, in words, until dismissed.
+#[component]
+fn LinkProblem() -> impl IntoView {
+    let console = use_console();
+    let problem = console.conn.last_problem;
+    view! {
+        <Show when=move || problem.with(|p| p.is_some())>
+            <div class="toast" role="status">
+                <span>{move || problem.get().unwrap_or_default()}</span>
+                <button on:click=move |_| problem.set(None)>"Dismiss"</button>
+            </div>
+        </Show>
+    }
+}

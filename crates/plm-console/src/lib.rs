@@ -1,0 +1,17 @@
+//! PLM Console: the browser console for ST power line modems.
+//!
+//! - [`transport`]: byte transports with T_REQ (the simulated modem).
+//! - [`session`]: plm-core's host link engine over a transport, requests
+//!   matched with their answers.
+//! - [`traffic`]: the inspector's bounded, filterable, exportable log.
+//! - [`mibform`]: MIB forms read from plm-core's declarative description.
+//! - [`app`], [`stores`], [`views`]: the Leptos application.
+
+pub mod mibform;
+pub mod session;
+pub mod traffic;
+pub mod transport;
+
+pub mod app;
+pub mod stores;
+pub mod views;

@@ -1,0 +1,282 @@
+//! The form model of a MIB object, read from plm-core's declarative
+//! description (`plm_core::mib::Object` and its `Field`s): what each input
+//! shows, and the value a filled-in form makes, checked field by field as
+//! the chip would check it before anything is sent. No object has a form
+//! of its own: the Modem view renders every one from this.
+
+use plm_core::field::{Field, Kind};
+use plm_core::mib::Object;
+use std::collections::BTreeMap;
+
+/// The text an input shows for a field of `data`: numbers in decimal,
+/// enums and flags as their raw value, bytes as hex.
+pub fn input_text(field: &Field, data: &[u8]) -> String {
+    match field.kind {
+        Kind::Bytes => match field.read(data) {
+            Some(plm_core::field::Value::Bytes(b)) => plm_core::hex::encode(&b),
+            _ => String::new(),
+        },
+        _ => field.get(data).map(|v| v.to_string()).unwrap_or_default(),
+    }
+}
+
+/// A field's value in words, with its unit (`86000 Hz`, `Q-PSK`).
+pub fn show(field: &Field, data: &[u8]) -> String {
+    match field.read(data) {
+        None => "–".to_string(),
+        Some(v) if field.unit.is_empty() || v.as_i64().is_none() => v.to_string(),
+        Some(v) => format!("{v} {}", field.unit),
+    }
+}
+
+/// The fields a person sets: not reserved or unused bits.
+pub fn editable(object: &'static Object) -> impl Iterator<Item = &'static Field> {
+    object.fields.iter().filter(|f| f.settable)
+}
+
+/// The fields whose values differ between `a` and `b`.
+pub fn differences(object: &'static Object, a: &[u8], b: &[u8]) -> Vec<&'static Field> {
+    object
+        .fields
+        .iter()
+        .filter(|f| f.read(a) != f.read(b))
+        .collect()
+}
+
+/// Why a form cannot be sent: reasons by field name, and one for the
+/// object as a whole.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Problems {
+    /// Field name to the reason, in words.
+    pub fields: BTreeMap<&'static str, String>,
+    /// A reason that is no one field's (length, reserved bits of the base).
+    pub object: Option<String>,
+}
+
+fn number(text: &str) -> Result<i64, String> {
+    let t = text.trim();
+    let parsed = match t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
+        Some(hex) => i64::from_str_radix(hex, 16),
+        None => t.parse::<i64>(),
+    };
+    parsed.map_err(|_| {
+        if t.is_empty() {
+            "enter a value".to_string()
+        } else {
+            format!("\"{t}\" is not a whole number")
+        }
+    })
+}
+
+/// Puts one input into `data`, checked as the chip checks the field.
+fn apply(field: &Field, text: &str, data: &mut [u8]) -> Result<(), String> {
+    if let Kind::Bytes = field.kind {
+        let bytes = plm_core::hex::parse(text).map_err(|e| e.to_string())?;
+        let want = if field.size == 0 {
+            data.len().saturating_sub(field.offset)
+        } else {
+            field.size
+        };
+        if bytes.len() != want {
+            return Err(format!(
+                "{want} bytes (as {} hex digits) are needed, not {}",
+                2 * want,
+                bytes.len()
+            ));
+        }
+        data[field.offset..field.offset + want].copy_from_slice(&bytes);
+        return Ok(());
+    }
+    let v = number(text)?;
+    field.check(v).map_err(|e| e.reason)?;
+    field.set(data, v);
+    Ok(())
+}
+
+/// The value the form makes: `base` (the value last read, or the factory
+/// default) with every input applied. Reserved bits keep the base's.
+/// Every field's problem is reported, not only the first, and the whole
+/// value is then checked as a MIB_WriteRequest would be.
+pub fn build(
+    object: &'static Object,
+    base: &[u8],
+    inputs: &BTreeMap<&'static str, String>,
+) -> Result<Vec<u8>, Problems> {
+    let mut data = base.to_vec();
+    data.resize(object.len, 0);
+    let mut problems = Problems::default();
+    for f in editable(object) {
+        let Some(text) = inputs.get(f.name) else {
+            continue;
+        };
+        if let Err(why) = apply(f, text, &mut data) {
+            problems.fields.insert(f.name, why);
+        }
+    }
+    if problems.fields.is_empty() {
+        if let Err(e) = object.check_value(&data) {
+            match e {
+                plm_core::mib::MibError::Field(fe) => {
+                    problems.fields.insert(fe.field, fe.reason);
+                }
+                other => problems.object = Some(other.to_string()),
+            }
+        }
+    }
+    if problems.fields.is_empty() && problems.object.is_none() {
+        Ok(data)
+    } else {
+        Err(problems)
+    }
+}
+
+/// What a saved profile file says it is.
+pub const PROFILE_FORMAT: &str = "plm-console MIB profile";
+
+/// A configuration profile: values of writable MIB objects, saved to and
+/// loaded from a JSON file (`{"format":…, "chip":"ST7580", "objects":
+/// {"01": "014ff0…"}}`, values as lowercase hex).
+pub fn profile_json(values: &BTreeMap<u8, Vec<u8>>) -> String {
+    let mut objects = serde_json::Map::new();
+    for o in plm_core::mib::ST7580.iter().filter(|o| o.access.write) {
+        if let Some(v) = values.get(&(o.index as u8)) {
+            objects.insert(
+                format!("{:02x}", o.index),
+                serde_json::Value::String(plm_core::hex::encode(v)),
+            );
+        }
+    }
+    let v = serde_json::json!({
+        "format": PROFILE_FORMAT,
+        "chip": "ST7580",
+        "objects": objects,
+    });
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// Reads a profile file; every value is checked as a MIB_WriteRequest
+/// would be, and the first problem refuses the whole file.
+pub fn parse_profile(text: &str) -> Result<Vec<(u8, Vec<u8>)>, String> {
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| format!("not JSON ({e})"))?;
+    if v.get("format").and_then(|f| f.as_str()) != Some(PROFILE_FORMAT) {
+        return Err(format!(
+            "not a profile: \"format\" must be \"{PROFILE_FORMAT}\""
+        ));
+    }
+    if v.get("chip").and_then(|c| c.as_str()) != Some("ST7580") {
+        return Err("the profile is not for the ST7580".to_string());
+    }
+    let objects = v
+        .get("objects")
+        .and_then(|o| o.as_object())
+        .ok_or("the profile has no \"objects\"")?;
+    let mut out = Vec::new();
+    for (key, value) in objects {
+        let index = u8::from_str_radix(key, 16)
+            .map_err(|_| format!("\"{key}\" is not a MIB index in hex"))?;
+        let hex = value
+            .as_str()
+            .ok_or_else(|| format!("object {key}: the value must be a hex string"))?;
+        let data = plm_core::hex::parse(hex).map_err(|e| format!("object {key}: {e}"))?;
+        plm_core::st7580::mib::check_write(index, &data)
+            .map_err(|e| format!("object {index:02X}h: {e}"))?;
+        out.push((index, data));
+    }
+    if out.is_empty() {
+        return Err("the profile has no objects".to_string());
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plm_core::st7580::mib::{index, object, phy_config};
+
+    fn inputs(object: &'static Object, data: &[u8]) -> BTreeMap<&'static str, String> {
+        editable(object)
+            .map(|f| (f.name, input_text(f, data)))
+            .collect()
+    }
+
+    #[test]
+    fn every_object_round_trips_its_default_through_the_form() {
+        for o in plm_core::mib::ST7580 {
+            let got = build(o, o.default, &inputs(o, o.default));
+            assert_eq!(got.as_deref(), Ok(o.default), "{}", o.name);
+        }
+    }
+
+    #[test]
+    fn a_changed_frequency_lands_in_its_bytes() {
+        let o = object(index::PHY_CONFIG).unwrap();
+        let mut i = inputs(o, o.default);
+        i.insert("high_frequency", "110000".into());
+        let data = build(o, o.default, &i).unwrap();
+        assert_eq!(&data[..3], &[0x01, 0xAD, 0xB0]);
+        assert_eq!(phy_config::HIGH_FREQUENCY.get(&data), Some(110_000));
+        assert_eq!(
+            differences(o, o.default, &data),
+            [&phy_config::HIGH_FREQUENCY]
+        );
+        assert_eq!(show(&phy_config::HIGH_FREQUENCY, &data), "110000 Hz");
+    }
+
+    #[test]
+    fn out_of_range_and_malformed_inputs_are_refused_with_reasons() {
+        let o = object(index::PHY_CONFIG).unwrap();
+        let mut i = inputs(o, o.default);
+        i.insert("high_frequency", "200000".into());
+        i.insert("tx_gain", "forty".into());
+        i.insert("psk_preamble_length", "7".into());
+        let p = build(o, o.default, &i).unwrap_err();
+        assert_eq!(
+            p.fields.get("high_frequency").map(String::as_str),
+            Some("200000 is out of range 3000..=148500 Hz")
+        );
+        assert_eq!(
+            p.fields.get("tx_gain").map(String::as_str),
+            Some("\"forty\" is not a whole number")
+        );
+        assert!(p.fields["psk_preamble_length"].starts_with("7 is not one of 0 = 16 bit"));
+    }
+
+    #[test]
+    fn the_key_must_be_sixteen_bytes_and_reserved_bits_of_the_base_are_refused() {
+        let key = object(index::SS_KEY).unwrap();
+        let mut i = inputs(key, key.default);
+        i.insert("ss_key", "00112233".into());
+        let p = build(key, key.default, &i).unwrap_err();
+        assert_eq!(
+            p.fields["ss_key"],
+            "16 bytes (as 32 hex digits) are needed, not 4"
+        );
+        let mc = object(index::MODEM_CONFIG).unwrap();
+        let p = build(mc, &[0x31], &inputs(mc, &[0x31])).unwrap_err();
+        assert_eq!(p.fields["reserved"], "Reserved bits must be 0, not 1");
+    }
+
+    #[test]
+    fn profiles_save_writable_objects_and_load_them_checked() {
+        let mut values = BTreeMap::new();
+        values.insert(
+            index::PHY_CONFIG,
+            object(index::PHY_CONFIG).unwrap().default.to_vec(),
+        );
+        values.insert(index::FIRMWARE_VERSION, vec![0, 0x42, 0, 0x97]);
+        let text = profile_json(&values);
+        let back = parse_profile(&text).unwrap();
+        assert_eq!(
+            back,
+            [(index::PHY_CONFIG, values[&index::PHY_CONFIG].clone())]
+        );
+        let bad = text.replace("014ff0", "030d40");
+        assert_eq!(
+            parse_profile(&bad),
+            Err("object 01h: high_frequency: 200000 is out of range 3000..=148500 Hz".into())
+        );
+        assert!(parse_profile("{}")
+            .unwrap_err()
+            .starts_with("not a profile"));
+    }
+}

@@ -1,0 +1,666 @@
+//! The session: plm-core's host link engine driven over a transport with
+//! the page's timers, requests matched with their answers, and everything
+//! that happened handed to the console's stores as [`Note`]s.
+//!
+//! The session has no browser in it (time comes in as an argument, after
+//! quinn-proto), so its tests run natively against the simulated modem.
+//!
+//! - Each tick lets the transport's time run up to the page's clock in
+//!   slices of at most [`SLICE`], feeding the engine every received byte
+//!   with its arrival time and calling `handle_timeout` at its deadlines.
+//! - Requests go to the modem one at a time: UM0932 has no sequence
+//!   numbers, so an answer is matched by `code::answers` to the one request
+//!   outstanding. After a request that had to be repeated for want of an
+//!   ACK the modem may have executed it twice (protocol notes, "Known
+//!   limits"); a second answer of the same kind within [`DUPLICATE_GRACE`]
+//!   is reported as such and never taken for the next request's.
+
+use crate::transport::{LinkState, Transport};
+use plm_core::decode::{Decoded, Decoder};
+use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
+use plm_core::link::{Dialect, Element, LocalFrame, Source, Timeouts};
+use plm_core::st7580::mib::{index, MibObject};
+use plm_core::st7580::{code, Command};
+use plm_core::time::{Duration, Instant, MS};
+use std::collections::VecDeque;
+
+/// Longest step of the transport's time between two looks at the engine:
+/// the host answers a modem frame at most this late (T_ACK is 40 ms).
+pub const SLICE: Duration = MS;
+/// How far the transport's time may be behind the page's clock before the
+/// difference is given up: after the page was busy or hidden the
+/// simulated world slows down rather than fast-forwarding.
+pub const MAX_CATCH_UP: Duration = 100 * MS;
+/// How long after its answer a request repeated for want of an ACK may
+/// still see a second answer.
+pub const DUPLICATE_GRACE: Duration = 200 * MS;
+
+/// What became of a request.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Outcome {
+    /// The modem's answer (confirm, error or CMD_SyntaxError) and the time
+    /// from handing the request to the link to the answer's last byte.
+    Answer {
+        /// The answer.
+        command: Command,
+        /// Round-trip time, µs.
+        rtt: Duration,
+    },
+    /// The request was not answered; why, in words, with what to do.
+    Failed(String),
+}
+
+/// Called once with the outcome of a request.
+pub type Reply = Box<dyn FnOnce(Outcome)>;
+
+/// Something that happened, for the stores.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Note {
+    /// An element on the wire, either way, decoded by plm-core.
+    Traffic {
+        /// When, µs on the transport's clock.
+        at: Instant,
+        /// The element, named as `plm decode` names it.
+        decoded: Box<Decoded>,
+    },
+    /// A status message arrived: the byte after `?`.
+    Status {
+        /// When.
+        at: Instant,
+        /// The status byte (UM0932 Table 8).
+        byte: u8,
+    },
+    /// T_REQ changed; `true` is asserted (low).
+    TReq(bool),
+    /// A frame from the modem that answers no request (indications,
+    /// duplicates).
+    Unsolicited {
+        /// When.
+        at: Instant,
+        /// The frame.
+        command: Command,
+        /// Whether it is a second answer to a request already answered.
+        duplicate: bool,
+    },
+    /// An attempt to deliver a request failed and is being repeated.
+    Retry {
+        /// When.
+        at: Instant,
+        /// Attempts so far.
+        attempt: u8,
+        /// Why, in words.
+        cause: String,
+    },
+    /// The host engine's timeouts changed (MIB 09h written, or reset).
+    Timeouts(Timeouts),
+}
+
+/// What a tick produced: notes for the stores and replies to call, both to
+/// be handled once the session is no longer borrowed.
+#[derive(Default)]
+pub struct Tick {
+    /// In order of occurrence.
+    pub notes: Vec<Note>,
+    /// Replies with their outcomes.
+    pub replies: Vec<(Reply, Outcome)>,
+}
+
+struct Queued {
+    command: Command,
+    reply: Reply,
+}
+
+struct Active {
+    ticket: Ticket,
+    command: Command,
+    reply: Reply,
+    submitted: Instant,
+    /// Set once the modem acknowledged the request.
+    deadline: Option<Instant>,
+    /// Whether an attempt went unacknowledged (the modem may have run it).
+    repeated: bool,
+}
+
+/// How long to wait for an answer once the modem acknowledged a request:
+/// a data request's confirm comes at the end of its power line frame.
+fn answer_timeout(request: u8) -> Duration {
+    match request {
+        code::PHY_DATA_REQUEST | code::DL_DATA_REQUEST | code::SS_DATA_REQUEST => 10_000 * MS,
+        _ => 2_000 * MS,
+    }
+}
+
+/// The host side of one connection.
+pub struct Session {
+    transport: Option<Box<dyn Transport>>,
+    host: HostEngine,
+    decoder: Decoder,
+    queue: VecDeque<Queued>,
+    active: Option<Active>,
+    /// A request code whose second answer is expected until the instant.
+    duplicate_of: Option<(u8, Instant)>,
+    /// Page time (µs) at which the transport's clock read 0.
+    origin: Option<f64>,
+    out: Tick,
+}
+
+impl Session {
+    /// A session over `transport` (or none yet).
+    pub fn new(transport: Option<Box<dyn Transport>>) -> Self {
+        let baud = transport.as_ref().map_or(57_600, |t| t.baud());
+        Session {
+            transport,
+            host: host_engine(baud),
+            decoder: Decoder::new(Dialect::St7580, Source::Any),
+            queue: VecDeque::new(),
+            active: None,
+            duplicate_of: None,
+            origin: None,
+            out: Tick::default(),
+        }
+    }
+
+    /// The transport, if connected to one.
+    pub fn transport(&self) -> Option<&dyn Transport> {
+        self.transport.as_deref()
+    }
+
+    /// The transport, to change it (fault injection, baud).
+    pub fn transport_mut(&mut self) -> Option<&mut (dyn Transport + 'static)> {
+        self.transport.as_deref_mut()
+    }
+
+    /// Whether bytes can flow, and if not why.
+    pub fn state(&self) -> LinkState {
+        match &self.transport {
+            Some(t) => t.state(),
+            None => LinkState::Disconnected(
+                "not connected: connect to the simulated modem (connection bar)".to_string(),
+            ),
+        }
+    }
+
+    /// Replaces the transport (or disconnects with `None`); every request
+    /// not yet answered fails with a message saying so.
+    pub fn replace_transport(&mut self, transport: Option<Box<dyn Transport>>) {
+        let why = "the connection was closed before the modem answered";
+        for (reply, outcome) in self.drop_requests(why) {
+            self.out.replies.push((reply, outcome));
+        }
+        let baud = transport.as_ref().map_or(57_600, |t| t.baud());
+        self.host = host_engine(baud);
+        self.decoder = Decoder::new(Dialect::St7580, Source::Any);
+        self.transport = transport;
+        self.origin = None;
+        self.duplicate_of = None;
+        self.out.notes.push(Note::TReq(false));
+        self.out
+            .notes
+            .push(Note::Timeouts(self.host.config().timeouts));
+    }
+
+    /// Changes the UART baud rate of the transport and the engine.
+    pub fn set_baud(&mut self, baud: u32) {
+        if let Some(t) = self.transport.as_mut() {
+            t.set_baud(baud);
+        }
+        let config = HostConfig {
+            baud,
+            ..self.host.config()
+        };
+        self.host.set_config(config);
+    }
+
+    /// The host-interface timeouts in use.
+    pub fn timeouts(&self) -> Timeouts {
+        self.host.config().timeouts
+    }
+
+    /// Requests not yet answered (the one outstanding and those queued).
+    pub fn outstanding(&self) -> usize {
+        self.queue.len() + self.active.is_some() as usize
+    }
+
+    /// Sends `command` to the modem; `reply` is called once with its fate.
+    pub fn request(&mut self, command: Command, reply: Reply) {
+        if let LinkState::Disconnected(why) = self.state() {
+            self.out.replies.push((reply, Outcome::Failed(why)));
+            return;
+        }
+        self.queue.push_back(Queued { command, reply });
+        let now = self.now();
+        self.start_next(now);
+        self.drain(now);
+    }
+
+    /// The transport's clock (0 when there is none).
+    pub fn now(&self) -> Instant {
+        self.transport.as_ref().map_or(0, |t| t.now())
+    }
+
+    /// Lets the transport's time catch up with the page's clock `page_us`
+    /// (µs, any origin) and returns what happened.
+    pub fn tick(&mut self, page_us: f64) -> Tick {
+        if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
+            let origin = *self.origin.get_or_insert(page_us - start as f64);
+            let mut target = (page_us - origin).max(0.0) as Instant;
+            if target > start + MAX_CATCH_UP {
+                target = start + MAX_CATCH_UP;
+                self.origin = Some(page_us - target as f64);
+            }
+            self.run_until(start, target);
+        }
+        self.take()
+    }
+
+    /// What happened since the last call, without letting time pass.
+    pub fn take(&mut self) -> Tick {
+        std::mem::take(&mut self.out)
+    }
+
+    fn run_until(&mut self, start: Instant, target: Instant) {
+        let mut t = start;
+        while t < target {
+            let mut next = (t + SLICE).min(target);
+            if let Some(d) = self.host.poll_timeout() {
+                if d > t && d < next {
+                    next = d;
+                }
+            }
+            let Some(transport) = self.transport.as_mut() else {
+                return;
+            };
+            let received = transport.poll(next);
+            for (at, byte) in received {
+                self.host.handle_rx(at, &[byte]);
+                self.drain(at);
+            }
+            if self.host.poll_timeout().is_some_and(|d| d <= next) {
+                self.host.handle_timeout(next);
+            }
+            self.expire(next);
+            self.start_next(next);
+            self.drain(next);
+            t = next;
+        }
+    }
+
+    /// Hands the next queued request to the engine when none is
+    /// outstanding and no duplicate answer is expected.
+    fn start_next(&mut self, now: Instant) {
+        if self.active.is_some() {
+            return;
+        }
+        if let Some((_, until)) = self.duplicate_of {
+            if now < until {
+                return;
+            }
+            self.duplicate_of = None;
+        }
+        let Some(q) = self.queue.pop_front() else {
+            return;
+        };
+        let ticket = self.host.submit(now, q.command.to_frame());
+        self.active = Some(Active {
+            ticket,
+            command: q.command,
+            reply: q.reply,
+            submitted: now,
+            deadline: None,
+            repeated: false,
+        });
+    }
+
+    fn expire(&mut self, now: Instant) {
+        let late = self
+            .active
+            .as_ref()
+            .and_then(|a| a.deadline)
+            .is_some_and(|d| now >= d);
+        if late {
+            if let Some(a) = self.active.take() {
+                let secs = answer_timeout(a.command.code()) / 1_000_000;
+                let msg = format!(
+                    "the modem acknowledged {} but sent no answer within {secs} s: reset the modem (Diagnostics) and try again",
+                    a.command.name().unwrap_or("the request")
+                );
+                self.out.replies.push((a.reply, Outcome::Failed(msg)));
+            }
+        }
+    }
+
+    /// Writes what the engine wants written and handles its events.
+    fn drain(&mut self, now: Instant) {
+        while let Some(tx) = self.host.poll_transmit() {
+            let Some(t) = self.transport.as_mut() else {
+                break;
+            };
+            match tx {
+                Transmit::Bytes(b) => t.write(&b),
+                Transmit::TReq { asserted } => {
+                    t.set_treq(asserted);
+                    self.out.notes.push(Note::TReq(asserted));
+                }
+            }
+        }
+        while let Some(e) = self.host.poll_event() {
+            self.on_event(now, e);
+        }
+    }
+
+    fn traffic(&mut self, at: Instant, element: &Element, from: &str) {
+        let mut decoded = self.decoder.decode(element);
+        decoded.from = Some(from.to_string());
+        self.out.notes.push(Note::Traffic {
+            at,
+            decoded: Box::new(decoded),
+        });
+    }
+
+    fn on_event(&mut self, now: Instant, e: Event) {
+        match e {
+            Event::Received(el) => {
+                if let Element::Status(s) = &el {
+                    if let Some(&byte) = s.data().first() {
+                        self.out.notes.push(Note::Status { at: now, byte });
+                    }
+                }
+                self.traffic(now, &el, "modem");
+            }
+            Event::Sent(el) => self.traffic(now, &el, "host"),
+            Event::Frame(f) => self.on_frame(now, f),
+            Event::Repeat(_) => {}
+            Event::Delivered(t) => {
+                if let Some(a) = self.active.as_mut().filter(|a| a.ticket == t) {
+                    a.deadline = Some(now + answer_timeout(a.command.code()));
+                }
+            }
+            Event::Failed(t, cause) => {
+                if self.active.as_ref().is_some_and(|a| a.ticket == t) {
+                    if let Some(a) = self.active.take() {
+                        self.out
+                            .replies
+                            .push((a.reply, Outcome::Failed(cause.to_string())));
+                    }
+                }
+            }
+            Event::Retry {
+                ticket,
+                attempt,
+                cause,
+            } => {
+                if let Some(a) = self.active.as_mut().filter(|a| a.ticket == ticket) {
+                    a.repeated |= cause == LinkError::NoAck;
+                }
+                self.out.notes.push(Note::Retry {
+                    at: now,
+                    attempt,
+                    cause: cause.to_string(),
+                });
+            }
+        }
+    }
+
+    fn on_frame(&mut self, now: Instant, f: LocalFrame) {
+        let answers_active = self
+            .active
+            .as_ref()
+            .is_some_and(|a| code::answers(a.command.code(), f.code));
+        let parsed = Command::from_frame(&f);
+        if answers_active {
+            let Some(a) = self.active.take() else {
+                return;
+            };
+            if a.repeated {
+                self.duplicate_of = Some((a.command.code(), now + DUPLICATE_GRACE));
+            }
+            let outcome = match parsed {
+                Ok(command) => {
+                    self.after_answer(&a.command, &command);
+                    Outcome::Answer {
+                        command,
+                        rtt: now.saturating_sub(a.submitted),
+                    }
+                }
+                Err(e) => Outcome::Failed(format!("the modem's answer does not fit: {e}")),
+            };
+            self.out.replies.push((a.reply, outcome));
+            return;
+        }
+        let Ok(command) = parsed else {
+            return;
+        };
+        let duplicate = self
+            .duplicate_of
+            .is_some_and(|(req, until)| now < until && code::answers(req, f.code));
+        if let Command::BioResetIndication(_) = command {
+            // UM0932 4.2.9 / protocol notes: a reset restores MIB 09h.
+            self.set_timeouts(Timeouts::default());
+        }
+        self.out.notes.push(Note::Unsolicited {
+            at: now,
+            command,
+            duplicate,
+        });
+    }
+
+    /// Keeps the engine's timeouts in step with a confirmed MIB 09h write.
+    fn after_answer(&mut self, request: &Command, answer: &Command) {
+        if let (Command::MibWriteRequest { index: i, data }, Command::MibWriteConfirm) =
+            (request, answer)
+        {
+            if *i == index::HOST_INTERFACE_TIMEOUT {
+                if let Some(t) = MibObject::decode(*i, data).ok().and_then(|o| o.timeouts()) {
+                    self.set_timeouts(t);
+                }
+            }
+        }
+    }
+
+    fn set_timeouts(&mut self, timeouts: Timeouts) {
+        let config = HostConfig {
+            timeouts,
+            ..self.host.config()
+        };
+        self.host.set_config(config);
+        self.out.notes.push(Note::Timeouts(timeouts));
+    }
+
+    fn drop_requests(&mut self, why: &str) -> Vec<(Reply, Outcome)> {
+        let mut out = Vec::new();
+        if let Some(a) = self.active.take() {
+            out.push((a.reply, Outcome::Failed(why.to_string())));
+        }
+        for q in self.queue.drain(..) {
+            out.push((q.reply, Outcome::Failed(why.to_string())));
+        }
+        out
+    }
+}
+
+fn host_engine(baud: u32) -> HostEngine {
+    HostEngine::new(
+        Dialect::St7580,
+        HostConfig {
+            baud,
+            ..HostConfig::default()
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transport::sim::SimTransport;
+    use plm_core::link::host::LinkError;
+    use plm_sim::Fault;
+    use std::cell::RefCell;
+    use std::rc::Rc;
+
+    type Seen = Rc<RefCell<Vec<Outcome>>>;
+
+    fn session(nodes: usize) -> Session {
+        Session::new(Some(Box::new(SimTransport::new(nodes, 57_600, 7))))
+    }
+
+    fn reply(seen: &Seen) -> Reply {
+        let seen = seen.clone();
+        Box::new(move |o| seen.borrow_mut().push(o))
+    }
+
+    /// Ticks every 4 ms of page time (as setInterval does) for `ms`,
+    /// calling the replies and keeping the notes.
+    fn run(s: &mut Session, page: &mut f64, ms: u32, notes: &mut Vec<Note>) {
+        for _ in 0..ms / 4 {
+            *page += 4_000.0;
+            let t = s.tick(*page);
+            notes.extend(t.notes);
+            for (r, o) in t.replies {
+                r(o);
+            }
+        }
+    }
+
+    #[test]
+    fn ping_is_answered_with_its_payload_and_a_round_trip_time() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (1_000_000.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes); // the modem boots in 20 ms
+        let seen = Seen::default();
+        s.request(
+            Command::PingRequest {
+                data: vec![1, 2, 3],
+            },
+            reply(&seen),
+        );
+        run(&mut s, &mut page, 100, &mut notes);
+        let seen = seen.borrow();
+        match &seen[..] {
+            [Outcome::Answer { command, rtt }] => {
+                assert_eq!(
+                    command,
+                    &Command::PingConfirm {
+                        data: vec![1, 2, 3]
+                    }
+                );
+                assert!(*rtt > 0 && *rtt < 20 * MS, "rtt {rtt}");
+            }
+            other => panic!("{other:?}"),
+        }
+        let kinds: Vec<_> = notes
+            .iter()
+            .filter_map(|n| match n {
+                Note::Traffic { decoded, .. } => decoded
+                    .command
+                    .as_ref()
+                    .and_then(|c| c.as_str())
+                    .map(str::to_string),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(
+            kinds,
+            ["BIO_ResetIndication", "PingRequest", "PingConfirm"],
+            "traffic of both directions, decoded"
+        );
+        assert!(notes.iter().any(|n| matches!(n, Note::Status { .. })));
+        assert!(notes.iter().any(|n| matches!(n, Note::TReq(true))));
+    }
+
+    #[test]
+    fn requests_queue_and_each_gets_its_own_answer() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (0.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes);
+        let seen = Seen::default();
+        for i in [index::FIRMWARE_VERSION, index::HOST_INTERFACE_TIMEOUT] {
+            s.request(Command::MibReadRequest { index: i }, reply(&seen));
+        }
+        assert_eq!(s.outstanding(), 2);
+        run(&mut s, &mut page, 200, &mut notes);
+        let data: Vec<_> = seen
+            .borrow()
+            .iter()
+            .map(|o| match o {
+                Outcome::Answer {
+                    command: Command::MibReadConfirm { data },
+                    ..
+                } => data.clone(),
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert_eq!(data, [vec![0x00, 0x42, 0x00, 0x97], vec![0xC8, 0x28, 0x0A]]);
+        assert_eq!(s.outstanding(), 0);
+    }
+
+    #[test]
+    fn an_unplugged_cable_fails_the_request_in_words() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (0.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes);
+        s.transport_mut()
+            .and_then(|t| t.simulator())
+            .expect("simulated")
+            .inject(Fault::Unplug);
+        let seen = Seen::default();
+        s.request(Command::PingRequest { data: vec![] }, reply(&seen));
+        run(&mut s, &mut page, 2_000, &mut notes);
+        assert_eq!(
+            *seen.borrow(),
+            [Outcome::Failed(
+                "the simulated cable is unplugged: plug it back in (Simulator view)".into()
+            )]
+        );
+        // Unplugged while the request is in flight: the link gives up.
+        s.transport_mut()
+            .and_then(|t| t.simulator())
+            .expect("simulated")
+            .inject(Fault::Plug);
+        s.request(Command::PingRequest { data: vec![] }, reply(&seen));
+        s.transport_mut()
+            .and_then(|t| t.simulator())
+            .expect("simulated")
+            .inject(Fault::Unplug);
+        run(&mut s, &mut page, 3_000, &mut notes);
+        assert_eq!(
+            seen.borrow()[1],
+            Outcome::Failed(LinkError::NoStatus.to_string())
+        );
+        assert!(notes.iter().any(|n| matches!(n, Note::Retry { .. })));
+    }
+
+    #[test]
+    fn a_confirmed_timeout_write_retunes_the_engine_and_a_reset_restores_it() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (0.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes);
+        let seen = Seen::default();
+        s.request(
+            Command::MibWriteRequest {
+                index: index::HOST_INTERFACE_TIMEOUT,
+                data: vec![150, 30, 8],
+            },
+            reply(&seen),
+        );
+        run(&mut s, &mut page, 100, &mut notes);
+        assert_eq!(s.timeouts(), Timeouts::from_ms(150, 30, 8));
+        s.request(Command::BioResetRequest, reply(&seen));
+        run(&mut s, &mut page, 200, &mut notes);
+        assert_eq!(s.timeouts(), Timeouts::default());
+        assert!(notes.iter().any(|n| matches!(
+            n,
+            Note::Unsolicited {
+                command: Command::BioResetIndication(_),
+                ..
+            }
+        )));
+    }
+
+    #[test]
+    fn a_stalled_page_slows_the_simulation_instead_of_racing_it() {
+        let mut s = session(1);
+        s.tick(0.0);
+        s.tick(5_000_000.0);
+        assert_eq!(s.now(), MAX_CATCH_UP);
+    }
+}

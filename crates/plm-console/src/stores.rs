@@ -1,0 +1,328 @@
+//! The console's shared state: a few stores of signals, passed to the
+//! views by context as one [`Console`], and the one place that applies a
+//! session's [`Note`]s to them.
+
+use crate::session::{Note, Outcome, Session, Tick};
+use crate::traffic::TrafficLog;
+use crate::transport::sim::SimTransport;
+use crate::transport::{LinkState, Simulator};
+use leptos::prelude::*;
+use plm_core::link::Timeouts;
+use plm_core::st7580::{Command, ErrorCause};
+use plm_core::time::Instant;
+use std::cell::RefCell;
+use std::collections::{BTreeMap, VecDeque};
+use std::rc::Rc;
+
+/// Seed of the simulated world (the same page, the same run).
+pub const SIM_SEED: u64 = 7580;
+/// Line events kept for the Simulator view.
+pub const LINE_EVENTS: usize = 200;
+
+/// The connection bar's state.
+#[derive(Clone, Copy)]
+pub struct ConnectionStore {
+    /// Whether bytes flow, and if not why.
+    pub state: RwSignal<LinkState>,
+    /// `Simulated`, or none.
+    pub kind: RwSignal<String>,
+    /// Which port or device.
+    pub port: RwSignal<String>,
+    /// UART baud rate.
+    pub baud: RwSignal<u32>,
+    /// T_REQ asserted (low).
+    pub treq: RwSignal<bool>,
+    /// The link engine's timeouts (MIB 09h).
+    pub timeouts: RwSignal<Timeouts>,
+    /// Attempts repeated by the link since connecting.
+    pub retries: RwSignal<u32>,
+    /// The last link problem, in words.
+    pub last_problem: RwSignal<Option<String>>,
+}
+
+/// The traffic inspector's log.
+#[derive(Clone, Copy)]
+pub struct TrafficStore {
+    /// Every element both ways.
+    pub log: RwSignal<TrafficLog>,
+    /// While paused: the last sequence number shown.
+    pub paused_at: RwSignal<Option<u64>>,
+}
+
+/// What the console knows of the modem.
+#[derive(Clone, Copy)]
+pub struct ModemStore {
+    /// The last status message byte and when it came.
+    pub status: RwSignal<Option<(Instant, u8)>>,
+    /// The last BIO_ResetIndication's ResetData and when it came.
+    pub last_reset: RwSignal<Option<(Instant, u8)>>,
+    /// The value of each MIB object as last read or written.
+    pub mib: RwSignal<BTreeMap<u8, Vec<u8>>>,
+}
+
+/// The Simulator view's state.
+#[derive(Clone, Copy)]
+pub struct SimStore {
+    /// Modems on the simulated line (1 = alone).
+    pub nodes: RwSignal<usize>,
+    /// Whether the simulated cable is plugged in.
+    pub plugged: RwSignal<bool>,
+    /// Frames echoed by the peers.
+    pub echoed: RwSignal<u64>,
+    /// Recent power line events, in words, newest last.
+    pub line_events: RwSignal<VecDeque<String>>,
+}
+
+/// Everything the views share; `Copy`, provided by context.
+#[derive(Clone, Copy)]
+pub struct Console {
+    session: StoredValue<Rc<RefCell<Session>>, LocalStorage>,
+    /// Connection bar.
+    pub conn: ConnectionStore,
+    /// Traffic inspector.
+    pub traffic: TrafficStore,
+    /// Modem state.
+    pub modem: ModemStore,
+    /// Simulator.
+    pub sim: SimStore,
+}
+
+/// The page's clock in µs.
+pub fn page_now_us() -> f64 {
+    web_sys::window()
+        .and_then(|w| w.performance())
+        .map_or(0.0, |p| p.now() * 1_000.0)
+}
+
+/// The console of the page; call once, in the root component.
+pub fn provide_console() -> Console {
+    let console = Console {
+        session: StoredValue::new_local(Rc::new(RefCell::new(Session::new(None)))),
+        conn: ConnectionStore {
+            state: RwSignal::new(LinkState::Disconnected("not connected".into())),
+            kind: RwSignal::new(String::new()),
+            port: RwSignal::new(String::new()),
+            baud: RwSignal::new(57_600),
+            treq: RwSignal::new(false),
+            timeouts: RwSignal::new(Timeouts::default()),
+            retries: RwSignal::new(0),
+            last_problem: RwSignal::new(None),
+        },
+        traffic: TrafficStore {
+            log: RwSignal::new(TrafficLog::default()),
+            paused_at: RwSignal::new(None),
+        },
+        modem: ModemStore {
+            status: RwSignal::new(None),
+            last_reset: RwSignal::new(None),
+            mib: RwSignal::new(BTreeMap::new()),
+        },
+        sim: SimStore {
+            nodes: RwSignal::new(1),
+            plugged: RwSignal::new(true),
+            echoed: RwSignal::new(0),
+            line_events: RwSignal::new(VecDeque::new()),
+        },
+    };
+    provide_context(console);
+    console
+}
+
+/// The console provided by the root component.
+pub fn use_console() -> Console {
+    expect_context::<Console>()
+}
+
+/// What is wrong with an answer, if it is a refusal, in words.
+pub fn refusal(answer: &Command) -> Option<String> {
+    let cause = |e: &ErrorCause| match e.name() {
+        Some(n) => n.to_string(),
+        None => format!("error {:02X}h", e.byte()),
+    };
+    use Command::*;
+    match answer {
+        BioResetError(e) | MibWriteError(e) | MibReadError(e) | MibEraseError(e)
+        | PhyDataError(e) | DlDataError(e) | SsDataError(e) => Some(format!(
+            "the modem refused it with {}: {}",
+            answer.name().unwrap_or("an error"),
+            cause(e)
+        )),
+        CmdSyntaxError { error } => Some(format!(
+            "the modem does not know command {error:02X}h (CMD_SyntaxError)"
+        )),
+        _ => None,
+    }
+}
+
+impl Console {
+    fn session(&self) -> Rc<RefCell<Session>> {
+        self.session.get_value()
+    }
+
+    /// Connects to a simulated modem with `nodes - 1` echoing peers.
+    pub fn connect_simulated(&self, nodes: usize) {
+        let baud = self.conn.baud.get_untracked();
+        let t = SimTransport::new(nodes, baud, SIM_SEED);
+        self.session()
+            .borrow_mut()
+            .replace_transport(Some(Box::new(t)));
+        self.sim.nodes.set(nodes);
+        self.sim.line_events.set(VecDeque::new());
+        self.modem.mib.set(BTreeMap::new());
+        self.modem.status.set(None);
+        self.conn.retries.set(0);
+        self.conn.last_problem.set(None);
+        self.refresh();
+    }
+
+    /// Closes the connection.
+    pub fn disconnect(&self) {
+        self.session().borrow_mut().replace_transport(None);
+        self.refresh();
+    }
+
+    /// Changes the baud rate.
+    pub fn set_baud(&self, baud: u32) {
+        self.session().borrow_mut().set_baud(baud);
+        self.conn.baud.set(baud);
+        self.refresh();
+    }
+
+    /// Sends `command`; `reply` gets its outcome.
+    pub fn request(&self, command: Command, reply: impl FnOnce(Outcome) + 'static) {
+        self.session()
+            .borrow_mut()
+            .request(command, Box::new(reply));
+        self.refresh();
+    }
+
+    /// Reads MIB object `index` into the modem store; `done` gets the value
+    /// or what went wrong.
+    pub fn read_mib(&self, index: u8, done: impl FnOnce(Result<Vec<u8>, String>) + 'static) {
+        let mib = self.modem.mib;
+        self.request(Command::MibReadRequest { index }, move |o| {
+            done(match o {
+                Outcome::Answer {
+                    command: Command::MibReadConfirm { data },
+                    ..
+                } => {
+                    mib.update(|m| {
+                        m.insert(index, data.clone());
+                    });
+                    Ok(data)
+                }
+                Outcome::Answer { command, .. } => {
+                    Err(refusal(&command).unwrap_or_else(|| "unexpected answer".into()))
+                }
+                Outcome::Failed(why) => Err(why),
+            })
+        });
+    }
+
+    /// Does something to the simulated world, if that is what is connected.
+    pub fn with_simulator(&self, f: impl FnOnce(&mut dyn Simulator)) {
+        {
+            let session = self.session();
+            let mut s = session.borrow_mut();
+            if let Some(sim) = s.transport_mut().and_then(|t| t.simulator()) {
+                f(sim);
+            }
+        }
+        self.refresh();
+    }
+
+    /// Lets time pass up to the page's clock: called by the page's timer.
+    pub fn tick(&self) {
+        let tick = self.session().borrow_mut().tick(page_now_us());
+        self.apply(tick);
+        self.refresh_sim();
+    }
+
+    /// Applies what happened without letting time pass.
+    fn refresh(&self) {
+        let (tick, state, kind, port) = {
+            let session = self.session();
+            let mut s = session.borrow_mut();
+            let tick = s.take();
+            let (kind, port) = s.transport().map_or((String::new(), String::new()), |t| {
+                (t.kind().into(), t.port())
+            });
+            (tick, s.state(), kind, port)
+        };
+        set_if_changed(self.conn.state, state);
+        set_if_changed(self.conn.kind, kind);
+        set_if_changed(self.conn.port, port);
+        self.apply(tick);
+        self.refresh_sim();
+    }
+
+    fn refresh_sim(&self) {
+        let (events, echoed, plugged, state) = {
+            let session = self.session();
+            let mut s = session.borrow_mut();
+            let state = s.state();
+            match s.transport_mut().and_then(|t| t.simulator()) {
+                Some(sim) => (sim.line_events(), sim.echoed(), sim.plugged(), Some(state)),
+                None => (Vec::new(), 0, true, None),
+            }
+        };
+        if let Some(state) = state {
+            set_if_changed(self.conn.state, state);
+        }
+        set_if_changed(self.sim.echoed, echoed);
+        set_if_changed(self.sim.plugged, plugged);
+        if !events.is_empty() {
+            self.sim.line_events.update(|l| {
+                for e in events {
+                    l.push_back(crate::views::simulator::describe_line_event(&e));
+                    if l.len() > LINE_EVENTS {
+                        l.pop_front();
+                    }
+                }
+            });
+        }
+    }
+
+    /// Applies notes to the stores, then calls the replies (the session is
+    /// not borrowed any more: a reply may send the next request).
+    fn apply(&self, tick: Tick) {
+        let Tick { notes, replies } = tick;
+        let mut traffic = Vec::new();
+        for n in notes {
+            match n {
+                Note::Traffic { at, decoded } => traffic.push((at, *decoded)),
+                Note::Status { at, byte } => self.modem.status.set(Some((at, byte))),
+                Note::TReq(level) => set_if_changed(self.conn.treq, level),
+                Note::Unsolicited { at, command, .. } => {
+                    if let Command::BioResetIndication(r) = command {
+                        self.modem.last_reset.set(Some((at, r.byte())));
+                    }
+                }
+                Note::Retry { cause, .. } => {
+                    self.conn.retries.update(|r| *r += 1);
+                    self.conn.last_problem.set(Some(cause));
+                }
+                Note::Timeouts(t) => set_if_changed(self.conn.timeouts, t),
+            }
+        }
+        if !traffic.is_empty() {
+            self.traffic.log.update(|log| {
+                for (at, d) in traffic {
+                    log.push(Some(at), d);
+                }
+            });
+        }
+        for (reply, outcome) in replies {
+            if let Outcome::Failed(why) = &outcome {
+                self.conn.last_problem.set(Some(why.clone()));
+            }
+            reply(outcome);
+        }
+    }
+}
+
+fn set_if_changed<T: PartialEq + Send + Sync + 'static>(signal: RwSignal<T>, value: T) {
+    if signal.with_untracked(|v| *v != value) {
+        signal.set(value);
+    }
+}

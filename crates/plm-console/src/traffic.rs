@@ -1,0 +1,364 @@
+//! The traffic log behind the inspector: every element both ways as
+//! plm-core decoded it, in a bounded buffer that counts what it dropped,
+//! with filters and JSON Lines export and import.
+//!
+//! A line of the export is exactly what `plm decode` prints for the
+//! element, with the time it was seen first: `{"time_us":…, "kind":…}`.
+//! Readers of `plm decode` output ignore the extra key, and the import
+//! takes `plm decode` output as it is (elements without a time).
+
+use plm_core::decode::Decoded;
+use plm_core::time::Instant;
+use serde_json::{Map, Value as Json};
+use std::collections::VecDeque;
+
+/// Elements kept before the oldest are dropped.
+pub const CAPACITY: usize = 5_000;
+
+/// One element of the log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entry {
+    /// Position in the log since it was cleared, for keys and pause.
+    pub seq: u64,
+    /// When it was seen, µs on the transport's clock (`None` if imported
+    /// without a time).
+    pub at: Option<Instant>,
+    /// The element as plm-core decoded it.
+    pub decoded: Decoded,
+    /// Its fields on one line, for the table.
+    pub summary: String,
+}
+
+impl Entry {
+    /// `host`, `modem` or `?`.
+    pub fn from(&self) -> &str {
+        self.decoded.from.as_deref().unwrap_or("?")
+    }
+
+    /// The command name, the kind for other elements.
+    pub fn title(&self) -> String {
+        match &self.decoded.command {
+            Some(Json::String(s)) => s.clone(),
+            Some(_) => match self.decoded.code {
+                Some(c) => format!("unknown command {c:02X}h"),
+                None => "unknown command".to_string(),
+            },
+            None => match self.decoded.kind.as_str() {
+                "ack" => "ACK".to_string(),
+                "nak" => "NAK".to_string(),
+                "status" => "status message".to_string(),
+                other => other.to_string(),
+            },
+        }
+    }
+
+    /// The line of the JSON Lines export.
+    pub fn to_json_line(&self) -> String {
+        let mut map = Map::new();
+        if let Some(t) = self.at {
+            map.insert("time_us".into(), Json::from(t));
+        }
+        if let Ok(Json::Object(fields)) = serde_json::to_value(&self.decoded) {
+            map.extend(fields);
+        }
+        Json::Object(map).to_string()
+    }
+}
+
+/// A field value as people read it: strings without quotes.
+fn show(v: &Json) -> String {
+    match v {
+        Json::String(s) => s.clone(),
+        Json::Null => "–".to_string(),
+        other => other.to_string(),
+    }
+}
+
+/// The fields of an element on one line.
+pub fn summary(d: &Decoded) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    if let Some(fields) = &d.fields {
+        for (k, v) in fields {
+            parts.push(format!("{k}={}", show(v)));
+        }
+    }
+    if d.checksum_ok == Some(false) {
+        parts.push("WRONG CHECKSUM".to_string());
+    }
+    if let Some(r) = &d.reason {
+        parts.push(format!("reason={r}"));
+    }
+    if let Some(e) = &d.error {
+        parts.push(format!("error: {e}"));
+    }
+    parts.join("  ")
+}
+
+/// The bounded log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrafficLog {
+    entries: VecDeque<Entry>,
+    capacity: usize,
+    next_seq: u64,
+    dropped: u64,
+}
+
+impl Default for TrafficLog {
+    fn default() -> Self {
+        TrafficLog::with_capacity(CAPACITY)
+    }
+}
+
+impl TrafficLog {
+    /// A log that keeps at most `capacity` elements.
+    pub fn with_capacity(capacity: usize) -> Self {
+        TrafficLog {
+            entries: VecDeque::new(),
+            capacity: capacity.max(1),
+            next_seq: 0,
+            dropped: 0,
+        }
+    }
+
+    /// Adds an element, dropping the oldest when full.
+    pub fn push(&mut self, at: Option<Instant>, decoded: Decoded) {
+        if self.entries.len() == self.capacity {
+            self.entries.pop_front();
+            self.dropped += 1;
+        }
+        let summary = summary(&decoded);
+        self.entries.push_back(Entry {
+            seq: self.next_seq,
+            at,
+            decoded,
+            summary,
+        });
+        self.next_seq += 1;
+    }
+
+    /// Empties the log.
+    pub fn clear(&mut self) {
+        self.entries.clear();
+        self.dropped = 0;
+    }
+
+    /// Elements kept.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether nothing is kept.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Elements dropped because the buffer was full.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// The sequence number the next element will get.
+    pub fn next_seq(&self) -> u64 {
+        self.next_seq
+    }
+
+    /// The elements, oldest first.
+    pub fn iter(&self) -> impl DoubleEndedIterator<Item = &Entry> {
+        self.entries.iter()
+    }
+
+    /// The element with this sequence number.
+    pub fn get(&self, seq: u64) -> Option<&Entry> {
+        let first = self.entries.front()?.seq;
+        self.entries.get(seq.checked_sub(first)? as usize)
+    }
+
+    /// The whole log as JSON Lines.
+    pub fn export(&self) -> String {
+        let mut s = String::new();
+        for e in &self.entries {
+            s.push_str(&e.to_json_line());
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Replaces the log with the elements of a JSON Lines text (an export,
+    /// or `plm decode` output). Lines that are not elements are skipped and
+    /// reported; nothing is imported if no line is.
+    pub fn import(&mut self, text: &str) -> Result<Imported, String> {
+        let mut elements = Vec::new();
+        let mut skipped = Vec::new();
+        for (i, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() {
+                continue;
+            }
+            match parse_line(line) {
+                Ok(e) => elements.push(e),
+                Err(why) => skipped.push(format!("line {}: {why}", i + 1)),
+            }
+        }
+        if elements.is_empty() {
+            return Err(match skipped.first() {
+                Some(first) => format!("no traffic element in the file ({first})"),
+                None => "the file is empty".to_string(),
+            });
+        }
+        self.clear();
+        let count = elements.len();
+        for (at, d) in elements {
+            self.push(at, d);
+        }
+        Ok(Imported { count, skipped })
+    }
+}
+
+/// What an import read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Imported {
+    /// Elements imported.
+    pub count: usize,
+    /// Lines skipped, each with its number and why.
+    pub skipped: Vec<String>,
+}
+
+fn parse_line(line: &str) -> Result<(Option<Instant>, Decoded), String> {
+    let v: Json = serde_json::from_str(line).map_err(|e| format!("not JSON ({e})"))?;
+    let Json::Object(mut map) = v else {
+        return Err("not a JSON object".to_string());
+    };
+    let at = match map.remove("time_us") {
+        None => None,
+        Some(t) => Some(
+            t.as_u64()
+                .ok_or_else(|| "time_us is not a whole number of µs".to_string())?,
+        ),
+    };
+    let d: Decoded =
+        serde_json::from_value(Json::Object(map)).map_err(|e| format!("not an element ({e})"))?;
+    plm_core::hex::parse(&d.hex).map_err(|e| format!("hex: {e}"))?;
+    Ok((at, d))
+}
+
+/// Which elements to show.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Filter {
+    /// `host`, `modem`, or empty for both.
+    pub from: String,
+    /// `frame`, `ack`, `nak`, `status`, `garbage`, or empty for all.
+    pub kind: String,
+    /// A command name (`MIB_ReadConfirm`), or empty for all.
+    pub command: String,
+}
+
+impl Filter {
+    /// Whether `e` passes.
+    pub fn matches(&self, e: &Entry) -> bool {
+        (self.from.is_empty() || e.from() == self.from)
+            && (self.kind.is_empty() || e.decoded.kind == self.kind)
+            && (self.command.is_empty()
+                || e.decoded.command.as_ref().and_then(|c| c.as_str()) == Some(&self.command))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plm_core::decode::decode_all;
+    use plm_core::link::{Dialect, Source};
+
+    fn elements(source: Source, hex: &str) -> Vec<Decoded> {
+        let bytes = plm_core::hex::parse(hex).unwrap();
+        decode_all(Dialect::St7580, source, &bytes)
+    }
+
+    fn log() -> TrafficLog {
+        let mut log = TrafficLog::default();
+        // PingRequest (host), then ACK, status and PingConfirm (modem).
+        for (i, d) in elements(Source::Host, "02 02 2c 01 02 31 00")
+            .into_iter()
+            .chain(elements(Source::Modem, "06 3f 11 02 02 2d 01 02 32 00"))
+            .enumerate()
+        {
+            log.push(Some(1_000 * i as u64), d);
+        }
+        log
+    }
+
+    #[test]
+    fn a_full_buffer_drops_the_oldest_and_counts_them() {
+        let mut log = TrafficLog::with_capacity(3);
+        for d in elements(Source::Modem, "06 06 15 06 15") {
+            log.push(None, d);
+        }
+        assert_eq!(log.len(), 3);
+        assert_eq!(log.dropped(), 2);
+        assert_eq!(log.iter().next().map(|e| e.seq), Some(2));
+        assert_eq!(log.get(4).map(|e| e.decoded.kind.as_str()), Some("nak"));
+        assert_eq!(log.get(1), None);
+    }
+
+    #[test]
+    fn filters_by_direction_kind_and_command() {
+        let log = log();
+        let titles = |f: &Filter| -> Vec<String> {
+            log.iter()
+                .filter(|e| f.matches(e))
+                .map(|e| e.title())
+                .collect()
+        };
+        assert_eq!(
+            titles(&Filter::default()),
+            ["PingRequest", "ACK", "status message", "PingConfirm"]
+        );
+        let modem_frames = Filter {
+            from: "modem".into(),
+            kind: "frame".into(),
+            ..Filter::default()
+        };
+        assert_eq!(titles(&modem_frames), ["PingConfirm"]);
+        let cmd = Filter {
+            command: "PingRequest".into(),
+            ..Filter::default()
+        };
+        assert_eq!(titles(&cmd), ["PingRequest"]);
+    }
+
+    #[test]
+    fn export_then_import_gives_the_same_log() {
+        let log = log();
+        let text = log.export();
+        assert_eq!(text.lines().count(), 4);
+        assert!(
+            text.starts_with(r#"{"time_us":0,"kind":"frame","from":"host","hex":"02022c0102310"#)
+        );
+        let mut back = TrafficLog::default();
+        let got = back.import(&text).unwrap();
+        assert_eq!(got.count, 4);
+        let strip =
+            |l: &TrafficLog| -> Vec<_> { l.iter().map(|e| (e.at, e.decoded.clone())).collect() };
+        assert_eq!(strip(&back), strip(&log));
+    }
+
+    #[test]
+    fn import_takes_plm_decode_output_and_reports_bad_lines() {
+        let plain: Vec<String> = elements(Source::Any, "02 00 2c 2c 00 06")
+            .iter()
+            .map(|d| serde_json::to_string(d).unwrap())
+            .collect();
+        let text = format!("{}\nnot json\n\n{}\n[1]\n", plain[0], plain[1]);
+        let mut log = TrafficLog::default();
+        let got = log.import(&text).unwrap();
+        assert_eq!(got.count, 2);
+        assert_eq!(got.skipped.len(), 2);
+        assert!(
+            got.skipped[0].starts_with("line 2: not JSON"),
+            "{:?}",
+            got.skipped
+        );
+        assert_eq!(log.iter().next().unwrap().title(), "PingRequest");
+        assert!(log.import("nothing here").is_err());
+        assert_eq!(log.len(), 2, "a failed import keeps the log");
+    }
+}

@@ -1,0 +1,80 @@
+//! Byte transports to a modem's host interface, behind one trait.
+//!
+//! A transport moves bytes and the T_REQ line, and says what time it is;
+//! it knows nothing of frames. The [`crate::session`] drives plm-core's
+//! host link engine over it. Two kinds are planned (DESIGN.md): the
+//! simulated modem in the page ([`sim::SimTransport`], the default) and
+//! WebSerial to real hardware (not built yet).
+
+pub mod sim;
+
+use plm_core::time::Instant;
+use plm_sim::{Fault, LineConfig, LineEvent};
+
+/// Whether a transport can carry bytes now.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum LinkState {
+    /// Bytes flow.
+    Connected,
+    /// Nothing crosses; the reason in words (what to do about it).
+    Disconnected(String),
+}
+
+impl LinkState {
+    /// Whether bytes flow.
+    pub fn is_connected(&self) -> bool {
+        matches!(self, LinkState::Connected)
+    }
+}
+
+/// A byte transport with a T_REQ line, driven by the session.
+///
+/// Time is in microseconds on the transport's own clock: virtual time for
+/// the simulator, the page's clock for a real port. Received bytes carry
+/// the time they arrived, so that the link engine can apply T_IC (UM0932
+/// 3.2.6) however late the page gets to them.
+pub trait Transport {
+    /// What kind of transport this is (`Simulated`, `WebSerial`).
+    fn kind(&self) -> &'static str;
+    /// Which port or device, in words.
+    fn port(&self) -> String;
+    /// Whether bytes can flow, and if not why.
+    fn state(&self) -> LinkState;
+    /// The transport's clock, µs.
+    fn now(&self) -> Instant;
+    /// UART baud rate.
+    fn baud(&self) -> u32;
+    /// Changes the UART baud rate.
+    fn set_baud(&mut self, baud: u32);
+    /// Writes bytes now.
+    fn write(&mut self, bytes: &[u8]);
+    /// Sets T_REQ now; `asserted` means pulled low (a request to send).
+    fn set_treq(&mut self, asserted: bool);
+    /// Lets time run up to `until` (no further than the clock allows) and
+    /// returns the bytes received meanwhile, with their arrival times.
+    fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)>;
+    /// The simulated world behind this transport, if it is one.
+    fn simulator(&mut self) -> Option<&mut dyn Simulator> {
+        None
+    }
+}
+
+/// What the Simulator view can do to a simulated transport.
+pub trait Simulator {
+    /// Modems on the line (1 = alone).
+    fn nodes(&self) -> usize;
+    /// Frames the echoing peers have sent back so far.
+    fn echoed(&self) -> u64;
+    /// Line conditions.
+    fn line(&self) -> LineConfig;
+    /// Changes the line conditions.
+    fn set_line(&mut self, line: LineConfig);
+    /// Random byte faults on one direction of the UART.
+    fn set_byte_faults(&mut self, dir: plm_sim::Dir, faults: plm_sim::ByteFaults);
+    /// Injects a fault now.
+    fn inject(&mut self, fault: Fault);
+    /// Whether the cable is plugged in.
+    fn plugged(&self) -> bool;
+    /// Line events since the last call, oldest first.
+    fn line_events(&mut self) -> Vec<LineEvent>;
+}

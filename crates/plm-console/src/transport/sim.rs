@@ -1,0 +1,115 @@
+//! The simulated transport: plm-sim's modem (and its power line, with any
+//! echoing peers) running in the page. Its clock is the simulation's
+//! virtual time, which the session moves on in step with the page's clock.
+
+use super::{LinkState, Simulator, Transport};
+use plm_core::time::Instant;
+use plm_sim::{ByteFaults, Dir, Fault, LineConfig, LineEvent, Sim, SimConfig};
+
+/// A simulated modem on node 0 of a simulated power line.
+#[derive(Debug, Clone)]
+pub struct SimTransport {
+    sim: Sim,
+}
+
+impl SimTransport {
+    /// `nodes` modems (1 = this modem alone, more = echoing peers), every
+    /// UART at `baud`, one seed for the whole run.
+    pub fn new(nodes: usize, baud: u32, seed: u64) -> Self {
+        SimTransport {
+            sim: Sim::new(SimConfig {
+                seed,
+                nodes: nodes.max(1),
+                baud,
+                ..SimConfig::default()
+            }),
+        }
+    }
+}
+
+impl Transport for SimTransport {
+    fn kind(&self) -> &'static str {
+        "Simulated"
+    }
+
+    fn port(&self) -> String {
+        match self.sim.nodes() {
+            1 => "ST7580 (simulated, alone)".to_string(),
+            2 => "ST7580 (simulated, 1 echoing peer)".to_string(),
+            n => format!("ST7580 (simulated, {} echoing peers)", n - 1),
+        }
+    }
+
+    fn state(&self) -> LinkState {
+        if self.sim.plugged() {
+            LinkState::Connected
+        } else {
+            LinkState::Disconnected(
+                "the simulated cable is unplugged: plug it back in (Simulator view)".to_string(),
+            )
+        }
+    }
+
+    fn now(&self) -> Instant {
+        self.sim.now()
+    }
+
+    fn baud(&self) -> u32 {
+        self.sim.baud()
+    }
+
+    fn set_baud(&mut self, baud: u32) {
+        self.sim.set_baud(baud);
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        self.sim.write(bytes);
+    }
+
+    fn set_treq(&mut self, asserted: bool) {
+        self.sim.set_treq(asserted);
+    }
+
+    fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)> {
+        self.sim.advance_to(until);
+        self.sim.host_read()
+    }
+
+    fn simulator(&mut self) -> Option<&mut dyn Simulator> {
+        Some(self)
+    }
+}
+
+impl Simulator for SimTransport {
+    fn nodes(&self) -> usize {
+        self.sim.nodes()
+    }
+
+    fn echoed(&self) -> u64 {
+        (1..self.sim.nodes()).map(|n| self.sim.echoed(n)).sum()
+    }
+
+    fn line(&self) -> LineConfig {
+        self.sim.line().clone()
+    }
+
+    fn set_line(&mut self, line: LineConfig) {
+        self.sim.set_line(line);
+    }
+
+    fn set_byte_faults(&mut self, dir: Dir, faults: ByteFaults) {
+        self.sim.set_byte_faults(dir, faults);
+    }
+
+    fn inject(&mut self, fault: Fault) {
+        self.sim.inject(fault);
+    }
+
+    fn plugged(&self) -> bool {
+        self.sim.plugged()
+    }
+
+    fn line_events(&mut self) -> Vec<LineEvent> {
+        std::iter::from_fn(|| self.sim.poll_line_event()).collect()
+    }
+}

@@ -1,0 +1,107 @@
+//! The connection bar, always visible: state, transport and port, baud,
+//! chip, T_REQ level and the link's timeouts.
+
+use crate::stores::use_console;
+use crate::transport::LinkState;
+use leptos::prelude::*;
+use plm_sim::BAUD_RATES;
+
+/// Whether the browser offers WebSerial (`navigator.serial`).
+fn has_web_serial() -> bool {
+    web_sys::window()
+        .map(|w| js_sys::Reflect::has(&w.navigator(), &"serial".into()).unwrap_or(false))
+        .unwrap_or(false)
+}
+
+/// The bar.
+#[component]
+pub fn ConnectionBar() -> impl IntoView {
+    let c = use_console();
+    let conn = c.conn;
+    let connected = move || conn.state.with(LinkState::is_connected);
+    let serial_note = if has_web_serial() {
+        "WebSerial: a later release"
+    } else {
+        "WebSerial: not in this browser"
+    };
+    let serial_title = if has_web_serial() {
+        "Real modems over WebSerial come in a later release; the simulated modem works now."
+    } else {
+        "This browser has no WebSerial (navigator.serial): use Chrome or Edge for a real modem. The simulated modem works here."
+    };
+    view! {
+        <div class="conn" id="connection" aria-label="Connection">
+            <span
+                id="conn-state"
+                class="state"
+                class:ok=connected
+                title=move || match conn.state.get() {
+                    LinkState::Connected => "Bytes flow".to_string(),
+                    LinkState::Disconnected(why) => why,
+                }
+            >
+                {move || if connected() { "● Connected" } else { "○ Disconnected" }}
+            </span>
+            <label>
+                "Transport "
+                <select id="transport" title=serial_title>
+                    <option value="sim" selected>"Simulated modem"</option>
+                    <option value="serial" disabled>{serial_note}</option>
+                </select>
+            </label>
+            <span class="item" id="conn-port" title="Port">{move || conn.port.get()}</span>
+            <label>
+                "Baud "
+                <select
+                    id="baud"
+                    on:change=move |ev| {
+                        if let Ok(b) = event_target_value(&ev).parse::<u32>() {
+                            c.set_baud(b);
+                        }
+                    }
+                >
+                    {BAUD_RATES
+                        .iter()
+                        .map(|&b| {
+                            view! {
+                                <option value=b.to_string() selected=move || conn.baud.get() == b>
+                                    {b.to_string()}
+                                </option>
+                            }
+                        })
+                        .collect_view()}
+                </select>
+            </label>
+            <span class="item">"Chip " <b>"ST7580"</b></span>
+            <span class="item" id="conn-treq" title="T_REQ: low = the host asks to send">
+                "T_REQ "
+                <b class:low=move || conn.treq.get()>
+                    {move || if conn.treq.get() { "low" } else { "high" }}
+                </b>
+            </span>
+            <span class="item muted" title="Host-interface timeouts (MIB 09h)">
+                {move || {
+                    let t = conn.timeouts.get();
+                    format!(
+                        "T_SR {} · T_ACK {} · T_IC {} ms",
+                        t.t_sr / 1000,
+                        t.t_ack / 1000,
+                        t.t_ic / 1000,
+                    )
+                }}
+            </span>
+            <button
+                id="connect"
+                on:click=move |_| {
+                    if c.conn.kind.get_untracked().is_empty() {
+                        c.connect_simulated(c.sim.nodes.get_untracked());
+                    } else {
+                        c.disconnect();
+                    }
+                }
+            >
+                {move || if conn.kind.get().is_empty() { "Connect" } else { "Disconnect" }}
+            </button>
+        </div>
+    }
+}

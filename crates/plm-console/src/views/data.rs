@@ -1,0 +1,438 @@
+//! The Data view: PHY, DL and SS data requests with the options of UM0932
+//! Tables 35 and 45, checked by plm-core before sending, their confirms
+//! decoded; and the power line frames received (data and sniffer
+//! indications) as plm-core decoded them in the traffic log.
+
+use super::{millis, seconds, spaced};
+use crate::session::Outcome;
+use crate::stores::{refusal, use_console};
+use crate::traffic::Entry;
+use leptos::prelude::*;
+use plm_core::st7580::fields::{confirm_data, tx_options, MODULATIONS};
+use plm_core::st7580::mib::{index, ModemConfig};
+use plm_core::st7580::{
+    validate, Command, DataRequest, FrequencySet, Modulation, SsDataRequest, TxParams,
+};
+
+const INDICATIONS: &[&str] = &[
+    "PHY_DataIndication",
+    "DL_DataIndication",
+    "DL_SnifferIndication",
+    "SS_DataIndication",
+    "SS_SnifferIndication",
+];
+
+fn field(e: &Entry, name: &str) -> String {
+    e.decoded
+        .fields
+        .as_ref()
+        .and_then(|f| f.get(name))
+        .map(|v| match v {
+            serde_json::Value::String(s) => s.clone(),
+            serde_json::Value::Null => "–".into(),
+            v => v.to_string(),
+        })
+        .unwrap_or_default()
+}
+
+fn payload(e: &Entry) -> String {
+    [
+        "phy_payload",
+        "dl_payload",
+        "dl_payload_and_wrong_crc",
+        "ss_header_and_payload",
+        "ss_sdu",
+    ]
+    .iter()
+    .map(|k| field(e, k))
+    .find(|p| !p.is_empty())
+    .unwrap_or_default()
+}
+
+/// The view.
+#[component]
+pub fn DataView() -> impl IntoView {
+    view! {
+        <div class="cards">
+            <DataRequestCard/>
+            <Indications/>
+        </div>
+    }
+}
+
+/// What the form says, before it is a command.
+#[derive(Clone)]
+struct Form {
+    layer: String,
+    modulation: String,
+    frequency: String,
+    custom_hz: String,
+    overwrite: bool,
+    gain: String,
+    zc: bool,
+    header_length: String,
+    text: bool,
+    payload: String,
+}
+
+/// The request a form makes, or the reason it cannot be sent.
+fn build(f: &Form, dl_crc_len: usize) -> Result<Command, String> {
+    let number = |what: &str, t: &str| -> Result<i64, String> {
+        t.trim()
+            .parse::<i64>()
+            .map_err(|_| format!("{what}: \"{}\" is not a whole number", t.trim()))
+    };
+    let modulation = Modulation::from_bits(number("modulation", &f.modulation)? as u8);
+    let tx_frequency = if f.frequency == "custom" {
+        let hz = number("TX frequency", &f.custom_hz)?;
+        tx_options::TX_FREQUENCY
+            .check(hz)
+            .map_err(|e| format!("TX frequency: {}", e.reason))?;
+        Some(hz as u32)
+    } else {
+        None
+    };
+    let tx_gain = if f.gain.trim().is_empty() {
+        None
+    } else {
+        let g = number("TX gain", &f.gain)?;
+        tx_options::TX_GAIN
+            .check(g)
+            .map_err(|e| format!("TX gain: {}", e.reason))?;
+        Some(g as u8)
+    };
+    let params = TxParams {
+        modulation,
+        frequency_set: if f.frequency == "low" {
+            FrequencySet::Low
+        } else {
+            FrequencySet::High
+        },
+        frequency_overwrite: tx_frequency.is_some() && f.overwrite,
+        zero_crossing_sync: f.zc,
+        tx_frequency,
+        tx_gain,
+    };
+    let payload = if f.text {
+        f.payload.as_bytes().to_vec()
+    } else {
+        plm_core::hex::parse(&f.payload).map_err(|e| format!("payload: {e}"))?
+    };
+    let cmd = match f.layer.as_str() {
+        "phy" => Command::PhyDataRequest(DataRequest { params, payload }),
+        "ss" => Command::SsDataRequest(SsDataRequest {
+            params,
+            header_length: u8::try_from(number("header length", &f.header_length)?)
+                .map_err(|_| "header length: 0..=255".to_string())?,
+            header_and_payload: payload,
+        }),
+        _ => Command::DlDataRequest(DataRequest { params, payload }),
+    };
+    if cmd.data().len() > 255 {
+        return Err(format!(
+            "the request carries {} bytes; a local frame carries at most 255",
+            cmd.data().len()
+        ));
+    }
+    validate::check_request(&cmd, dl_crc_len).map_err(|r| r.reason)?;
+    Ok(cmd)
+}
+
+#[component]
+fn DataRequestCard() -> impl IntoView {
+    let c = use_console();
+    let form = RwSignal::new(Form {
+        layer: "dl".into(),
+        modulation: "0".into(),
+        frequency: "high".into(),
+        custom_hz: "86000".into(),
+        overwrite: false,
+        gain: String::new(),
+        zc: false,
+        header_length: "4".into(),
+        text: true,
+        payload: "hello street".into(),
+    });
+    let result = RwSignal::new(None::<Result<String, String>>);
+    // The DL CRC length of MIB 00h (as last read, else its default) sets
+    // how long a DL or SS payload may be (UM0932 Tables 3, 4, 53).
+    let dl_crc_len = move || {
+        let mc = c
+            .modem
+            .mib
+            .with_untracked(|m| m.get(&index::MODEM_CONFIG).cloned());
+        let o = plm_core::st7580::mib::object(index::MODEM_CONFIG);
+        let data = mc
+            .or_else(|| o.map(|o| o.default.to_vec()))
+            .unwrap_or_default();
+        [1, 2, 4, 4][ModemConfig::decode(&data).crc_length as usize & 3]
+    };
+    let send = move |_| {
+        let cmd = match build(&form.get_untracked(), dl_crc_len()) {
+            Ok(cmd) => cmd,
+            Err(why) => {
+                result.set(Some(Err(format!("nothing sent: {why}"))));
+                return;
+            }
+        };
+        result.set(Some(Ok(format!(
+            "{} sent…",
+            cmd.name().unwrap_or("request")
+        ))));
+        c.request(cmd, move |o| {
+            result.set(Some(match o {
+                Outcome::Answer {
+                    command:
+                        command @ (Command::PhyDataConfirm(_)
+                        | Command::DlDataConfirm(_)
+                        | Command::SsDataConfirm(_)),
+                    rtt,
+                } => {
+                    let data = command.data();
+                    let fields: Vec<String> = plm_core::mib::describe(confirm_data::LAYOUT, &data)
+                        .into_iter()
+                        .map(|(f, v)| format!("{}: {v}", f.label))
+                        .collect();
+                    Ok(format!(
+                        "{} after {}: {}",
+                        command.name().unwrap_or("confirm"),
+                        millis(rtt),
+                        fields.join(", ")
+                    ))
+                }
+                Outcome::Answer { command, .. } => {
+                    Err(refusal(&command)
+                        .unwrap_or_else(|| format!("unexpected answer {command:?}")))
+                }
+                Outcome::Failed(why) => Err(why),
+            }))
+        });
+    };
+    let set = move |f: fn(&mut Form, String)| {
+        move |ev: leptos::ev::Event| form.update(|x| f(x, event_target_value(&ev)))
+    };
+    view! {
+        <article class="card wide" id="data-request">
+            <h3>"Send a frame"</h3>
+            <p class="muted">
+                "PHY_DataRequest, DL_DataRequest or SS_DataRequest (UM0932 Tables 35 and 45), checked as the modem checks it before it is sent."
+            </p>
+            <div class="form-row">
+                <label>
+                    "Layer "
+                    <select id="data-layer" on:change=set(|f, v| f.layer = v)>
+                        <option value="phy">"PHY"</option>
+                        <option value="dl" selected>"DL"</option>
+                        <option value="ss">"SS"</option>
+                    </select>
+                </label>
+                <label>
+                    "Modulation "
+                    <select id="data-modulation" on:change=set(|f, v| f.modulation = v)>
+                        {MODULATIONS
+                            .iter()
+                            .enumerate()
+                            .filter(|(_, n)| **n != "Reserved")
+                            .map(|(i, n)| view! { <option value=i.to_string()>{*n}</option> })
+                            .collect_view()}
+                    </select>
+                </label>
+                <label>
+                    "Frequency "
+                    <select id="data-frequency" on:change=set(|f, v| f.frequency = v)>
+                        <option value="high" selected>"MIB high frequency"</option>
+                        <option value="low">"MIB low frequency"</option>
+                        <option value="custom">"custom"</option>
+                    </select>
+                </label>
+                <label hidden=move || form.with(|f| f.frequency != "custom")>
+                    "Hz "
+                    <input
+                        id="data-custom-hz"
+                        size="7"
+                        prop:value=move || form.with(|f| f.custom_hz.clone())
+                        on:input=set(|f, v| f.custom_hz = v)
+                    />
+                </label>
+                <label hidden=move || form.with(|f| f.frequency != "custom")>
+                    <input
+                        type="checkbox"
+                        id="data-overwrite"
+                        on:change=move |ev| form.update(|f| f.overwrite = event_target_checked(&ev))
+                    />
+                    " overwrite MIB frequency"
+                </label>
+                <label title="Empty: the MIB's TX gain">
+                    "TX gain "
+                    <input
+                        id="data-gain"
+                        size="3"
+                        placeholder="MIB"
+                        prop:value=move || form.with(|f| f.gain.clone())
+                        on:input=set(|f, v| f.gain = v)
+                    />
+                </label>
+                <label>
+                    <input
+                        type="checkbox"
+                        id="data-zc"
+                        on:change=move |ev| form.update(|f| f.zc = event_target_checked(&ev))
+                    />
+                    " zero-crossing synchronisation"
+                </label>
+                <label hidden=move || form.with(|f| f.layer != "ss")>
+                    "SS header length "
+                    <input
+                        id="data-header-length"
+                        size="3"
+                        prop:value=move || form.with(|f| f.header_length.clone())
+                        on:input=set(|f, v| f.header_length = v)
+                    />
+                </label>
+            </div>
+            <div class="form-row">
+                <label>
+                    "Payload as "
+                    <select
+                        id="data-payload-kind"
+                        on:change=move |ev| form.update(|f| f.text = event_target_value(&ev) == "text")
+                    >
+                        <option value="text" selected>"text"</option>
+                        <option value="hex">"hex"</option>
+                    </select>
+                </label>
+                <input
+                    id="data-payload"
+                    class="payload"
+                    size="60"
+                    prop:value=move || form.with(|f| f.payload.clone())
+                    on:input=set(|f, v| f.payload = v)
+                />
+                <button id="data-send" on:click=send>"Send"</button>
+            </div>
+            <p id="data-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
+                {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
+            </p>
+        </article>
+    }
+}
+
+#[component]
+fn Indications() -> impl IntoView {
+    let c = use_console();
+    let rows = Memo::new(move |_| {
+        c.traffic.log.with(|l| {
+            l.iter()
+                .filter(|e| {
+                    e.decoded
+                        .command
+                        .as_ref()
+                        .and_then(|c| c.as_str())
+                        .is_some_and(|c| INDICATIONS.contains(&c))
+                })
+                .cloned()
+                .collect::<Vec<_>>()
+        })
+    });
+    view! {
+        <article class="card wide" id="data-indications">
+            <h3>"Received frames"</h3>
+            <p class="muted">
+                "Data and sniffer indications from the modem (UM0932 Table 39). With echoing peers (Simulator view) every frame sent comes back."
+            </p>
+            <table class="log" id="indications-table">
+                <thead>
+                    <tr>
+                        <th>"Time"</th>
+                        <th>"Indication"</th>
+                        <th>"Modulation"</th>
+                        <th>"Channel"</th>
+                        <th>"PGA"</th>
+                        <th>"SNR (dB)"</th>
+                        <th>"ZC delay (13 µs)"</th>
+                        <th>"Payload"</th>
+                    </tr>
+                </thead>
+                <tbody>
+                    <For
+                        each=move || rows.get()
+                        key=|e| e.seq
+                        children=move |e| {
+                            view! {
+                                <tr>
+                                    <td class="time">{e.at.map(seconds).unwrap_or_default()}</td>
+                                    <td>{e.title()}</td>
+                                    <td>{field(&e, "frame_modulation")}</td>
+                                    <td>{field(&e, "rx_channel")}</td>
+                                    <td>{field(&e, "pga_value")}</td>
+                                    <td>{field(&e, "snr")}</td>
+                                    <td>{field(&e, "zc_delay")}</td>
+                                    <td class="hex">{spaced(&payload(&e))}</td>
+                                </tr>
+                            }
+                        }
+                    />
+                </tbody>
+            </table>
+        </article>
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn form() -> Form {
+        Form {
+            layer: "dl".into(),
+            modulation: "1".into(),
+            frequency: "high".into(),
+            custom_hz: "86000".into(),
+            overwrite: false,
+            gain: String::new(),
+            zc: false,
+            header_length: "4".into(),
+            text: true,
+            payload: "hi".into(),
+        }
+    }
+
+    #[test]
+    fn a_dl_request_carries_the_options_and_payload() {
+        let mut f = form();
+        f.frequency = "custom".into();
+        f.custom_hz = "110000".into();
+        f.gain = "20".into();
+        let Ok(Command::DlDataRequest(r)) = build(&f, 4) else {
+            panic!("a DL request");
+        };
+        assert_eq!(r.params.modulation, Modulation::QPsk);
+        assert_eq!(r.params.tx_frequency, Some(110_000));
+        assert_eq!(r.params.tx_gain, Some(20));
+        assert_eq!(r.payload, b"hi");
+    }
+
+    #[test]
+    fn what_the_modem_would_refuse_is_not_built() {
+        let mut f = form();
+        f.frequency = "custom".into();
+        f.custom_hz = "200000".into();
+        assert_eq!(
+            build(&f, 4),
+            Err("TX frequency: 200000 is out of range 3000..=148500 Hz".into())
+        );
+        let mut f = form();
+        f.gain = "40".into();
+        assert!(build(&f, 4)
+            .unwrap_err()
+            .starts_with("TX gain: 40 is out of range"));
+        let mut f = form();
+        f.layer = "ss".into();
+        f.header_length = "9".into();
+        assert!(build(&f, 4).is_err(), "header longer than the buffer");
+        let mut f = form();
+        f.text = false;
+        f.payload = "zz".into();
+        assert!(build(&f, 4).unwrap_err().starts_with("payload: "));
+    }
+}

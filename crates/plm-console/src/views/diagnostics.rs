@@ -1,0 +1,276 @@
+//! Diagnostics: ping with round-trip time, the live status message bits,
+//! firmware version, reset with the last reset cause, and the counters of
+//! MIB 06h-08h with erase.
+
+use super::{millis, seconds, spaced};
+use crate::session::Outcome;
+use crate::stores::{refusal, use_console};
+use leptos::prelude::*;
+use plm_core::field::Field;
+use plm_core::st7580::fields::{reset_data, status};
+use plm_core::st7580::mib::{index, object};
+use plm_core::st7580::Command;
+
+/// The view.
+#[component]
+pub fn DiagnosticsView() -> impl IntoView {
+    view! {
+        <div class="cards">
+            <PingCard/>
+            <StatusCard/>
+            <FirmwareCard/>
+            <ResetCard/>
+            <CountersCard/>
+        </div>
+    }
+}
+
+/// Named values of `data` under `layout`, as table rows.
+fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoView {
+    plm_core::mib::describe(layout, &data)
+        .into_iter()
+        .map(|(f, v)| {
+            let unit = if f.unit.is_empty() || v.as_i64().is_none() {
+                String::new()
+            } else {
+                format!(" {}", f.unit)
+            };
+            view! {
+                <tr data-field=f.name>
+                    <th>{f.label}</th>
+                    <td>{format!("{v}{unit}")}</td>
+                </tr>
+            }
+        })
+        .collect_view()
+}
+
+#[component]
+fn PingCard() -> impl IntoView {
+    let c = use_console();
+    let payload = RwSignal::new(String::from("50 4c 4d 21"));
+    let result = RwSignal::new(None::<Result<String, String>>);
+    let history = RwSignal::new(Vec::<u64>::new());
+    let ping =
+        move |_| {
+            let data = match plm_core::hex::parse(&payload.get_untracked()) {
+                Ok(d) if d.len() <= 255 => d,
+                Ok(d) => {
+                    result.set(Some(Err(format!(
+                        "nothing sent: a frame carries at most 255 bytes, not {}",
+                        d.len()
+                    ))));
+                    return;
+                }
+                Err(e) => {
+                    result.set(Some(Err(format!("nothing sent: {e}"))));
+                    return;
+                }
+            };
+            result.set(Some(Ok("sent, waiting for the answer…".into())));
+            let sent = data.clone();
+            c.request(Command::PingRequest { data }, move |o| {
+                result.set(Some(match o {
+                    Outcome::Answer {
+                        command: Command::PingConfirm { data },
+                        rtt,
+                    } => {
+                        history.update(|h| {
+                            h.push(rtt);
+                            if h.len() > 10 {
+                                h.remove(0);
+                            }
+                        });
+                        let same = if data == sent {
+                            "payload echoed intact"
+                        } else {
+                            "payload differs from the one sent!"
+                        };
+                        Ok(format!(
+                            "PingConfirm in {} ({same}): {}",
+                            millis(rtt),
+                            spaced(&plm_core::hex::encode(&data))
+                        ))
+                    }
+                    Outcome::Answer { command, .. } => Err(refusal(&command)
+                        .unwrap_or_else(|| format!("unexpected answer {command:?}"))),
+                    Outcome::Failed(why) => Err(why),
+                }))
+            });
+        };
+    view! {
+        <article class="card" id="ping">
+            <h3>"Ping"</h3>
+            <p class="muted">"PingRequest (2Ch): the modem sends the payload back (UM0932 3.3.10)."</p>
+            <label>
+                "Payload (hex) "
+                <input
+                    id="ping-payload"
+                    class="hex"
+                    size="30"
+                    prop:value=move || payload.get()
+                    on:input=move |ev| payload.set(event_target_value(&ev))
+                />
+            </label>
+            <button id="ping-send" on:click=ping>"Ping"</button>
+            <p id="ping-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
+                {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
+            </p>
+            <p class="muted" id="ping-history">
+                {move || {
+                    let h = history.get();
+                    (!h.is_empty())
+                        .then(|| {
+                            let list: Vec<String> = h.iter().map(|r| millis(*r)).collect();
+                            format!("Last round trips: {}", list.join(", "))
+                        })
+                }}
+            </p>
+        </article>
+    }
+}
+
+#[component]
+fn StatusCard() -> impl IntoView {
+    let c = use_console();
+    view! {
+        <article class="card" id="status">
+            <h3>"Status message"</h3>
+            <p class="muted">
+                "The bits of the last status message (UM0932 Table 8); the modem sends one each time the host asks to send."
+            </p>
+            {move || match c.modem.status.get() {
+                None => view! { <p class="muted">"No status message yet: send any request."</p> }.into_any(),
+                Some((at, byte)) => view! {
+                    <p>{format!("3F {byte:02X}, received at {}", seconds(at))}</p>
+                    <table class="kv">{field_rows(status::LAYOUT, vec![byte])}</table>
+                }
+                .into_any(),
+            }}
+        </article>
+    }
+}
+
+#[component]
+fn FirmwareCard() -> impl IntoView {
+    let c = use_console();
+    let message = RwSignal::new(None::<String>);
+    let value = move || {
+        c.modem
+            .mib
+            .with(|m| m.get(&index::FIRMWARE_VERSION).cloned())
+    };
+    view! {
+        <article class="card" id="firmware">
+            <h3>"Firmware version"</h3>
+            <p class="muted">"MIB 0Ah (UM0932 4.2.10)."</p>
+            <button
+                id="firmware-read"
+                on:click=move |_| {
+                    message.set(Some("reading…".into()));
+                    c.read_mib(index::FIRMWARE_VERSION, move |r| message.set(r.err()));
+                }
+            >
+                "Read"
+            </button>
+            <p id="firmware-value" class="big">
+                {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_uppercase()))}
+            </p>
+            <p class="problem">{move || message.get()}</p>
+        </article>
+    }
+}
+
+#[component]
+fn ResetCard() -> impl IntoView {
+    let c = use_console();
+    let message = RwSignal::new(None::<String>);
+    let reset = move |_| {
+        message.set(Some("BIO_ResetRequest sent…".into()));
+        c.request(Command::BioResetRequest, move |o| {
+            message.set(Some(match o {
+                Outcome::Answer {
+                    command: Command::BioResetConfirm { .. },
+                    ..
+                } => {
+                    "BIO_ResetConfirm: the modem restarts; its BIO_ResetIndication follows.".into()
+                }
+                Outcome::Answer { command, .. } => {
+                    refusal(&command).unwrap_or_else(|| "unexpected answer".into())
+                }
+                Outcome::Failed(why) => why,
+            }))
+        });
+    };
+    view! {
+        <article class="card" id="reset">
+            <h3>"Reset"</h3>
+            <p class="muted">
+                "BIO_ResetRequest (3Ch) restarts the modem; MIB 00h-02h survive if written since power-on (UM0932 3.3.1)."
+            </p>
+            <button id="reset-send" on:click=reset>"Reset modem"</button>
+            <p id="reset-result">{move || message.get()}</p>
+            <h4>"Last BIO_ResetIndication"</h4>
+            {move || match c.modem.last_reset.get() {
+                None => view! { <p class="muted">"None since connecting."</p> }.into_any(),
+                Some((at, byte)) => view! {
+                    <p>{format!("ResetData {byte:02X}h at {}", seconds(at))}</p>
+                    <table class="kv" id="reset-cause">{field_rows(reset_data::LAYOUT, vec![byte])}</table>
+                }
+                .into_any(),
+            }}
+        </article>
+    }
+}
+
+#[component]
+fn CountersCard() -> impl IntoView {
+    view! {
+        <article class="card wide" id="counters">
+            <h3>"Counters"</h3>
+            <p class="muted">"MIB 06h-08h (UM0932 Tables 58-60): 16-bit, wrapping; erase sets them to 0."</p>
+            <div class="counter-grid">
+                {[index::PHY_DATA, index::DL_DATA, index::SS_DATA]
+                    .into_iter()
+                    .map(|i| view! { <Counters index=i/> })
+                    .collect_view()}
+            </div>
+        </article>
+    }
+}
+
+#[component]
+fn Counters(index: u8) -> impl IntoView {
+    let c = use_console();
+    let o = object(index).expect("06h-08h are in Table 52");
+    let message = RwSignal::new(None::<String>);
+    let value = move || c.modem.mib.with(|m| m.get(&index).cloned());
+    let read = move || {
+        c.read_mib(index, move |r| message.set(r.err()));
+    };
+    let erase = move |_| {
+        c.request(Command::MibEraseRequest { index }, move |o| match o {
+            Outcome::Answer {
+                command: Command::MibEraseConfirm,
+                ..
+            } => {
+                message.set(None);
+                read();
+            }
+            Outcome::Answer { command, .. } => message.set(refusal(&command)),
+            Outcome::Failed(why) => message.set(Some(why)),
+        });
+    };
+    view! {
+        <div class="counters" id=format!("counters-{index:02x}")>
+            <h4>{format!("{index:02X}h {}", o.name)}</h4>
+            <button data-action="read" on:click=move |_| read()>"Read"</button>
+            <button data-action="erase" on:click=erase>"Erase"</button>
+            {move || match value() {
+                None => view! { <p class="muted">"Not read yet."</p> }.into_any(),
+                Some(v) => view! { <table class="kv">{field_rows(o.fields, v)}</table> }.into_any(),
+            }}
+            <p class="problem">{move || message.get()}</p>
+        </div>
+    }
+}

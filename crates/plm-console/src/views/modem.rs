@@ -1,0 +1,519 @@
+//! The Modem view: every ST7580 MIB object, rendered from plm-core's
+//! declarative description. No object has a hand-written form: the rows,
+//! inputs, ranges, enums, access and defaults all come from
+//! `plm_core::mib::ST7580`, and a value is checked by `crate::mibform`
+//! (plm-core's `Field::check` and `Object::check_value`) before anything
+//! is sent.
+
+use super::files;
+use crate::mibform::{self, Problems};
+use crate::session::Outcome;
+use crate::stores::{refusal, use_console};
+use leptos::prelude::*;
+use plm_core::field::{Field, Kind};
+use plm_core::mib::Object;
+use plm_core::st7580::mib::index;
+use plm_core::st7580::Command;
+use std::collections::BTreeMap;
+use std::rc::Rc;
+
+type Inputs = BTreeMap<&'static str, String>;
+
+fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
+    mibform::editable(object)
+        .map(|f| (f.name, mibform::input_text(f, data)))
+        .collect()
+}
+
+/// The view.
+#[component]
+pub fn ModemView() -> impl IntoView {
+    let c = use_console();
+    let progress = RwSignal::new(None::<String>);
+    let read_all = move |_| {
+        let total = plm_core::mib::ST7580.len();
+        let done = RwSignal::new(0usize);
+        let failed = RwSignal::new(0usize);
+        progress.set(Some(format!("Reading 0 of {total}…")));
+        for o in plm_core::mib::ST7580 {
+            c.read_mib(o.index as u8, move |r| {
+                if r.is_err() {
+                    failed.update(|f| *f += 1);
+                }
+                done.update(|d| *d += 1);
+                let (d, f) = (done.get_untracked(), failed.get_untracked());
+                progress.set(Some(if d < total {
+                    format!("Reading {d} of {total}…")
+                } else if f == 0 {
+                    format!("Read all {total} objects.")
+                } else {
+                    format!(
+                        "Read {} of {total} objects; {f} failed (see each object).",
+                        d - f
+                    )
+                }));
+            });
+        }
+    };
+    view! {
+        <div class="toolbar">
+            <button id="mib-read-all" on:click=read_all>"Read all"</button>
+            <span class="muted" id="mib-progress">{move || progress.get()}</span>
+            <Profiles/>
+            <span class="muted">
+                "ST7580 MIB (UM0932 4, Table 52). Values are checked as the modem checks them before anything is sent."
+            </span>
+        </div>
+        <div class="mib-list">
+            {plm_core::mib::ST7580
+                .iter()
+                .map(|o| view! { <MibCard object=o/> })
+                .collect_view()}
+        </div>
+    }
+}
+
+/// Profiles: the writable objects' values saved to a JSON file, and loaded
+/// back, checked, then written as a batch with progress and cancel.
+#[component]
+fn Profiles() -> impl IntoView {
+    let c = use_console();
+    let message = RwSignal::new(None::<String>);
+    let running = RwSignal::new(false);
+    let cancel = RwSignal::new(false);
+    let save = move |_| {
+        let values = c.modem.mib.get_untracked();
+        let writable: Vec<u8> = plm_core::mib::ST7580
+            .iter()
+            .filter(|o| o.access.write)
+            .map(|o| o.index as u8)
+            .collect();
+        let have = writable.iter().filter(|i| values.contains_key(i)).count();
+        if have == 0 {
+            message.set(Some(
+                "Nothing to save yet: read the objects first (Read all).".into(),
+            ));
+            return;
+        }
+        let text = mibform::profile_json(&values);
+        message.set(Some(
+            match files::download("plm-profile.json", "application/json", &text) {
+                Ok(()) if have == writable.len() => {
+                    format!("Saved the {have} writable objects to plm-profile.json.")
+                }
+                Ok(()) => format!(
+                    "Saved {have} of {} writable objects (read the others to include them).",
+                    writable.len()
+                ),
+                Err(e) => e,
+            },
+        ));
+    };
+    let load = move |ev: leptos::ev::Event| {
+        let Some(file) = files::chosen_file(&ev) else {
+            return;
+        };
+        leptos::task::spawn_local(async move {
+            let name = file.name();
+            let list = match files::read_text(&file)
+                .await
+                .and_then(|t| mibform::parse_profile(&t))
+            {
+                Ok(list) => list,
+                Err(e) => {
+                    message.set(Some(format!("Nothing written from {name}: {e}.")));
+                    return;
+                }
+            };
+            cancel.set(false);
+            running.set(true);
+            apply_profile(c, Rc::new(list), 0, message, running, cancel);
+        });
+    };
+    view! {
+        <button id="profile-save" on:click=save>"Save profile"</button>
+        <label class="button">
+            "Load profile…"
+            <input id="profile-load" type="file" accept=".json,application/json" on:change=load/>
+        </label>
+        <Show when=move || running.get()>
+            <button id="profile-cancel" on:click=move |_| cancel.set(true)>"Cancel"</button>
+        </Show>
+        <span class="muted" id="profile-message">{move || message.get()}</span>
+    }
+}
+
+/// Writes object `i` of a loaded profile, then the next, reading each one
+/// back into the store; stops at the first refusal or on cancel.
+fn apply_profile(
+    c: crate::stores::Console,
+    list: Rc<Vec<(u8, Vec<u8>)>>,
+    i: usize,
+    message: RwSignal<Option<String>>,
+    running: RwSignal<bool>,
+    cancel: RwSignal<bool>,
+) {
+    let n = list.len();
+    if cancel.get_untracked() {
+        running.set(false);
+        message.set(Some(format!("Cancelled after {i} of {n} objects.")));
+        return;
+    }
+    let Some((index, data)) = list.get(i).cloned() else {
+        running.set(false);
+        message.set(Some(format!(
+            "Profile applied: {n} objects written and read back."
+        )));
+        return;
+    };
+    message.set(Some(format!("Writing {} of {n} ({index:02X}h)…", i + 1)));
+    c.request(Command::MibWriteRequest { index, data }, move |o| match o {
+        Outcome::Answer {
+            command: Command::MibWriteConfirm,
+            ..
+        } => c.read_mib(index, move |_| {
+            apply_profile(c, list, i + 1, message, running, cancel)
+        }),
+        Outcome::Answer { command, .. } => {
+            running.set(false);
+            message.set(Some(format!(
+                "Stopped at object {index:02X}h ({} of {n}): {}",
+                i + 1,
+                refusal(&command).unwrap_or_else(|| "unexpected answer".into())
+            )));
+        }
+        Outcome::Failed(why) => {
+            running.set(false);
+            message.set(Some(format!(
+                "Stopped at object {index:02X}h ({} of {n}): {why}",
+                i + 1
+            )));
+        }
+    });
+}
+
+/// One MIB object: its fields, read, write, erase and factory default.
+#[component]
+fn MibCard(object: &'static Object) -> impl IntoView {
+    let c = use_console();
+    let idx = object.index as u8;
+    let secret = idx == index::SS_KEY;
+    let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
+    let inputs = RwSignal::new(inputs_of(object, object.default));
+    Effect::new(move |_| {
+        if let Some(v) = read_value.get() {
+            inputs.set(inputs_of(object, &v));
+        }
+    });
+    let problems = RwSignal::new(Problems::default());
+    let status = RwSignal::new(String::from(
+        "not read yet: the form shows the factory default",
+    ));
+    let reveal = RwSignal::new(false);
+    let masked = Signal::derive(move || secret && !reveal.get());
+    let base = move || {
+        read_value
+            .get_untracked()
+            .unwrap_or_else(|| object.default.to_vec())
+    };
+
+    let read = move || {
+        status.set("reading…".into());
+        c.read_mib(idx, move |r| {
+            status.set(match r {
+                Ok(_) => "read from the modem".into(),
+                Err(e) => format!("not read: {e}"),
+            })
+        });
+    };
+    let write = move |_| {
+        let data = match mibform::build(object, &base(), &inputs.get_untracked()) {
+            Ok(d) => d,
+            Err(p) => {
+                let n = p.fields.len();
+                status.set(match &p.object {
+                    Some(why) => format!("nothing sent: {why}"),
+                    None => format!("nothing sent: {n} field(s) need fixing (see the reasons)"),
+                });
+                problems.set(p);
+                return;
+            }
+        };
+        problems.set(Problems::default());
+        status.set("writing…".into());
+        let sent = data.clone();
+        c.request(
+            Command::MibWriteRequest { index: idx, data },
+            move |o| match o {
+                Outcome::Answer {
+                    command: Command::MibWriteConfirm,
+                    ..
+                } => {
+                    status.set("written; reading back…".into());
+                    c.read_mib(idx, move |r| {
+                        status.set(match r {
+                            Ok(v) if v == sent => "written and read back: the modem has it".into(),
+                            Ok(_) => "written, but the modem reads back another value".into(),
+                            Err(e) => format!("written, but not read back: {e}"),
+                        })
+                    });
+                }
+                Outcome::Answer { command, .. } => status.set(format!(
+                    "not written: {}",
+                    refusal(&command).unwrap_or_else(|| "unexpected answer".into())
+                )),
+                Outcome::Failed(why) => status.set(format!("not written: {why}")),
+            },
+        );
+    };
+    let erase = move |_| {
+        status.set("erasing…".into());
+        c.request(Command::MibEraseRequest { index: idx }, move |o| match o {
+            Outcome::Answer {
+                command: Command::MibEraseConfirm,
+                ..
+            } => {
+                status.set("erased; reading back…".into());
+                c.read_mib(idx, move |r| {
+                    status.set(match r {
+                        Ok(_) => "erased and read back".into(),
+                        Err(e) => format!("erased, but not read back: {e}"),
+                    })
+                });
+            }
+            Outcome::Answer { command, .. } => status.set(format!(
+                "not erased: {}",
+                refusal(&command).unwrap_or_else(|| "unexpected answer".into())
+            )),
+            Outcome::Failed(why) => status.set(format!("not erased: {why}")),
+        });
+    };
+    let load_default = move |_| {
+        inputs.set(inputs_of(object, object.default));
+        problems.set(Problems::default());
+        status.set("factory default loaded into the form: Write to send it".into());
+    };
+    let diff = move || {
+        let v = read_value.get()?;
+        let d = mibform::differences(object, &v, object.default);
+        Some(if d.is_empty() {
+            "equal to the factory default".to_string()
+        } else {
+            let names: Vec<_> = d.iter().map(|f| f.label).collect();
+            format!(
+                "{} field(s) differ from the factory default: {}",
+                d.len(),
+                names.join(", ")
+            )
+        })
+    };
+    let writable = object.access.write;
+
+    view! {
+        <article class="card mib" id=format!("mib-{idx:02x}")>
+            <header>
+                <h3>
+                    <span class="index">{format!("{idx:02X}h")}</span>
+                    " "
+                    {object.name}
+                </h3>
+                <span class="access" title="Access (Table 52)">{object.access.label()}</span>
+                <span class="muted">{object.section}</span>
+            </header>
+            <div class="actions">
+                <button data-action="read" on:click=move |_| read()>"Read"</button>
+                {writable
+                    .then(|| {
+                        view! {
+                            <button data-action="write" on:click=write>"Write"</button>
+                            <button data-action="default" on:click=load_default>
+                                "Factory default"
+                            </button>
+                        }
+                    })}
+                {object
+                    .access
+                    .erase
+                    .then(|| view! { <button data-action="erase" on:click=erase>"Erase"</button> })}
+                {secret
+                    .then(|| {
+                        view! {
+                            <label class="reveal">
+                                <input
+                                    type="checkbox"
+                                    data-action="reveal"
+                                    prop:checked=move || reveal.get()
+                                    on:change=move |ev| reveal.set(event_target_checked(&ev))
+                                />
+                                " Reveal key"
+                            </label>
+                        }
+                    })}
+            </div>
+            <p class="status" data-role="status">{move || status.get()}</p>
+            {move || {
+                problems
+                    .with(|p| p.object.clone())
+                    .map(|o| view! { <p class="problem">{o}</p> })
+            }}
+            <table class="fields">
+                <thead>
+                    <tr>
+                        <th>"Field"</th>
+                        <th>"Value"</th>
+                        <th>"Allowed"</th>
+                        <th>"Factory default"</th>
+                        <th></th>
+                    </tr>
+                </thead>
+                <tbody>
+                    {object
+                        .fields
+                        .iter()
+                        .map(|f| {
+                            view! {
+                                <FieldRow
+                                    field=f
+                                    object=object
+                                    read_value=read_value
+                                    inputs=inputs
+                                    problems=problems
+                                    masked=masked
+                                    editable=writable && f.settable
+                                />
+                            }
+                        })
+                        .collect_view()}
+                </tbody>
+            </table>
+            <p class="diff" data-role="diff">{diff}</p>
+        </article>
+    }
+}
+
+/// One field: label, input (or value), what is allowed, the factory
+/// default, and why the form refused it.
+#[component]
+fn FieldRow(
+    field: &'static Field,
+    object: &'static Object,
+    read_value: Memo<Option<Vec<u8>>>,
+    inputs: RwSignal<Inputs>,
+    problems: RwSignal<Problems>,
+    masked: Signal<bool>,
+    editable: bool,
+) -> impl IntoView {
+    let name = field.name;
+    let current = move || read_value.get().unwrap_or_else(|| object.default.to_vec());
+    // Reserved and unused bits are shown only when they are not zero.
+    let visible = move || field.settable || field.get(&current()).is_some_and(|v| v != 0);
+    let differs = move || {
+        read_value
+            .get()
+            .is_some_and(|v| field.read(&v) != field.read(object.default))
+    };
+    let secret = move |text: String| {
+        if masked.get() {
+            "••••••••".to_string()
+        } else {
+            text
+        }
+    };
+    let allowed = match field.kind {
+        Kind::Bytes => format!("{} bytes, hex", field.size),
+        Kind::Flag => "yes / no".to_string(),
+        // The select lists the choices.
+        Kind::Enum(_) if editable => String::new(),
+        _ => field.allowed(),
+    };
+    let value = if editable {
+        field_input(field, inputs, masked).into_any()
+    } else {
+        view! { <span class="value">{move || secret(mibform::show(field, &current()))}</span> }
+            .into_any()
+    };
+    view! {
+        <tr
+            hidden=move || !visible()
+            class:differs=differs
+            class:invalid=move || problems.with(|p| p.fields.contains_key(name))
+            data-field=name
+        >
+            <th>
+                {field.label}
+                {(!field.unit.is_empty()).then(|| format!(" ({})", field.unit))}
+            </th>
+            <td>{value}</td>
+            <td class="muted">{allowed}</td>
+            <td class="muted">{move || secret(mibform::show(field, object.default))}</td>
+            <td class="problem" data-role="problem">
+                {move || problems.with(|p| p.fields.get(name).cloned())}
+            </td>
+        </tr>
+    }
+}
+
+/// The input of an editable field, by its kind.
+fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<bool>) -> AnyView {
+    let name = field.name;
+    let value = move || inputs.with(|m| m.get(name).cloned().unwrap_or_default());
+    let set = move |v: String| {
+        inputs.update(|m| {
+            m.insert(name, v);
+        })
+    };
+    match field.kind {
+        Kind::Enum(names) => view! {
+            <select name=name on:change=move |ev| set(event_target_value(&ev))>
+                {names
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, n)| !n.is_empty() && **n != "Reserved")
+                    .map(|(i, n)| {
+                        let raw = i.to_string();
+                        let r = raw.clone();
+                        view! {
+                            <option value=raw selected=move || value() == r>
+                                {n.to_string()}
+                            </option>
+                        }
+                    })
+                    .collect_view()}
+            </select>
+        }
+        .into_any(),
+        Kind::Flag => view! {
+            <input
+                type="checkbox"
+                name=name
+                prop:checked=move || value() == "1"
+                on:change=move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into())
+            />
+        }
+        .into_any(),
+        Kind::Bytes => view! {
+            <input
+                type=move || if masked.get() { "password" } else { "text" }
+                class="hex"
+                name=name
+                autocomplete="off"
+                spellcheck="false"
+                size="34"
+                prop:value=value
+                on:input=move |ev| set(event_target_value(&ev))
+            />
+        }
+        .into_any(),
+        _ => view! {
+            <input
+                type="text"
+                inputmode="numeric"
+                name=name
+                size="10"
+                prop:value=value
+                on:input=move |ev| set(event_target_value(&ev))
+            />
+        }
+        .into_any(),
+    }
+}

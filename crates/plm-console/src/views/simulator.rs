@@ -1,0 +1,345 @@
+//! The Simulator view: the simulated world behind the Simulated transport.
+//! Topology (this modem alone or with echoing peers), line conditions,
+//! UART byte faults, modem reset and unplug, and what happens on the line.
+
+use super::seconds;
+use crate::stores::use_console;
+use leptos::prelude::*;
+use plm_core::st7580::fields::MODULATIONS;
+use plm_core::st7580::Temperature;
+use plm_core::time::MS;
+use plm_sim::{ByteFaults, Dir, Fault, LineConfig, LineEvent};
+
+/// A line event in words.
+pub fn describe_line_event(e: &LineEvent) -> String {
+    match e {
+        LineEvent::Sent {
+            at,
+            from,
+            modulation,
+            frequency,
+            bytes,
+            airtime,
+        } => format!(
+            "{}  node {from} sends {bytes} bytes, {} at {frequency} Hz, {:.1} ms on the line",
+            seconds(*at),
+            MODULATIONS.get(modulation.bits() as usize).unwrap_or(&"?"),
+            *airtime as f64 / 1_000.0
+        ),
+        LineEvent::Heard {
+            at,
+            from,
+            to,
+            snr_db,
+            corrupted,
+        } => format!(
+            "{}  node {to} hears node {from}, SNR {snr_db:.1} dB{}",
+            seconds(*at),
+            if *corrupted {
+                ", with a corrupted byte"
+            } else {
+                ""
+            }
+        ),
+        LineEvent::Missed { at, from, to, why } => {
+            format!("{}  node {to} misses node {from}: {why}", seconds(*at))
+        }
+    }
+}
+
+/// The view.
+#[component]
+pub fn SimulatorView() -> impl IntoView {
+    view! {
+        <div class="cards">
+            <TopologyCard/>
+            <ModemFaultsCard/>
+            <LineCard/>
+            <UartCard/>
+            <LineEventsCard/>
+        </div>
+    }
+}
+
+#[component]
+fn TopologyCard() -> impl IntoView {
+    let c = use_console();
+    let choice = RwSignal::new(c.sim.nodes.get_untracked());
+    view! {
+        <article class="card" id="sim-topology">
+            <h3>"Topology"</h3>
+            <p class="muted">
+                "Node 0 is this console's modem. Peers (nodes 1…) sit along a street and send back every frame they receive, at the same layer and modulation."
+            </p>
+            <label>
+                "Modems "
+                <select
+                    id="sim-nodes"
+                    on:change=move |ev| {
+                        if let Ok(n) = event_target_value(&ev).parse() {
+                            choice.set(n);
+                        }
+                    }
+                >
+                    {[1usize, 2, 3, 5]
+                        .into_iter()
+                        .map(|n| {
+                            let label = match n {
+                                1 => "this modem alone".to_string(),
+                                2 => "with 1 echoing peer".to_string(),
+                                n => format!("with {} echoing peers", n - 1),
+                            };
+                            view! {
+                                <option value=n.to_string() selected=move || choice.get() == n>
+                                    {label}
+                                </option>
+                            }
+                        })
+                        .collect_view()}
+                </select>
+            </label>
+            <button id="sim-apply-topology" on:click=move |_| c.connect_simulated(choice.get_untracked())>
+                "Restart the simulation"
+            </button>
+            <p>
+                {move || format!("Running: {} modem(s); peers echoed {} frame(s).", c.sim.nodes.get(), c.sim.echoed.get())}
+            </p>
+        </article>
+    }
+}
+
+#[component]
+fn ModemFaultsCard() -> impl IntoView {
+    let c = use_console();
+    let inject = move |f: Fault| c.with_simulator(|s| s.inject(f));
+    view! {
+        <article class="card" id="sim-modem">
+            <h3>"Modem and cable"</h3>
+            <div class="buttons">
+                <button id="sim-reset" on:click=move |_| inject(Fault::ModemReset)>
+                    "Pull RESETN (power-on reset)"
+                </button>
+                <button id="sim-watchdog" on:click=move |_| inject(Fault::Watchdog)>
+                    "Watchdog reset"
+                </button>
+                <button
+                    id="sim-plug"
+                    on:click=move |_| {
+                        inject(if c.sim.plugged.get_untracked() { Fault::Unplug } else { Fault::Plug })
+                    }
+                >
+                    {move || if c.sim.plugged.get() { "Unplug the cable" } else { "Plug the cable in" }}
+                </button>
+            </div>
+            <label>
+                "Temperature "
+                <select
+                    id="sim-temperature"
+                    on:change=move |ev| {
+                        if let Ok(t) = event_target_value(&ev).parse::<u8>() {
+                            inject(Fault::Temperature(Temperature::from_bits(t)));
+                        }
+                    }
+                >
+                    <option value="0" selected>"below 70 °C"</option>
+                    <option value="1">"70-100 °C"</option>
+                    <option value="2">"100-125 °C"</option>
+                    <option value="3">"above 125 °C (refuses to transmit)"</option>
+                </select>
+            </label>
+        </article>
+    }
+}
+
+fn percent(text: &str) -> Option<f64> {
+    let v: f64 = text.trim().parse().ok()?;
+    (0.0..=100.0).contains(&v).then_some(v / 100.0)
+}
+
+#[component]
+fn LineCard() -> impl IntoView {
+    let c = use_console();
+    let defaults = LineConfig::default();
+    let noise = RwSignal::new(defaults.noise_dbuv.to_string());
+    let loss = RwSignal::new("0".to_string());
+    let corruption = RwSignal::new("0".to_string());
+    let message = RwSignal::new(None::<String>);
+    let apply = move |_| {
+        let noise_dbuv = match noise.get_untracked().trim().parse::<f64>() {
+            Ok(v) if (0.0..=130.0).contains(&v) => v,
+            _ => {
+                message.set(Some("noise floor: a number of dBµV from 0 to 130".into()));
+                return;
+            }
+        };
+        let (Some(loss), Some(corruption)) = (
+            percent(&loss.get_untracked()),
+            percent(&corruption.get_untracked()),
+        ) else {
+            message.set(Some(
+                "loss and corruption: percentages from 0 to 100".into(),
+            ));
+            return;
+        };
+        c.with_simulator(|s| {
+            s.set_line(LineConfig {
+                noise_dbuv,
+                loss,
+                corruption,
+                ..s.line()
+            })
+        });
+        message.set(Some("applied".into()));
+    };
+    view! {
+        <article class="card" id="sim-line">
+            <h3>"Power line"</h3>
+            <p class="muted">
+                "TX level 100 dBµV at full gain, 30 dB between neighbours, 2 dB more per node in between."
+            </p>
+            <label>
+                "Noise floor (dBµV) "
+                <input
+                    id="sim-noise"
+                    size="5"
+                    prop:value=move || noise.get()
+                    on:input=move |ev| noise.set(event_target_value(&ev))
+                />
+            </label>
+            <label>
+                "Frame loss (%) "
+                <input
+                    id="sim-loss"
+                    size="4"
+                    prop:value=move || loss.get()
+                    on:input=move |ev| loss.set(event_target_value(&ev))
+                />
+            </label>
+            <label>
+                "Corruption (%) "
+                <input
+                    id="sim-corruption"
+                    size="4"
+                    prop:value=move || corruption.get()
+                    on:input=move |ev| corruption.set(event_target_value(&ev))
+                />
+            </label>
+            <button id="sim-apply-line" on:click=apply>"Apply"</button>
+            <p class="muted">{move || message.get()}</p>
+        </article>
+    }
+}
+
+#[component]
+fn UartCard() -> impl IntoView {
+    let c = use_console();
+    let dir = RwSignal::new(Dir::HostToModem);
+    let drop = RwSignal::new("0".to_string());
+    let corrupt = RwSignal::new("0".to_string());
+    let delay = RwSignal::new("0".to_string());
+    let message = RwSignal::new(None::<String>);
+    let inject = move |f: Fault| {
+        c.with_simulator(|s| s.inject(f));
+        message.set(Some("armed: it hits the next byte".into()));
+    };
+    let apply = move |_| {
+        let (Some(drop), Some(corrupt), Some(delay)) = (
+            percent(&drop.get_untracked()),
+            percent(&corrupt.get_untracked()),
+            percent(&delay.get_untracked()),
+        ) else {
+            message.set(Some("percentages from 0 to 100".into()));
+            return;
+        };
+        let d = dir.get_untracked();
+        c.with_simulator(|s| {
+            s.set_byte_faults(
+                d,
+                ByteFaults {
+                    drop,
+                    corrupt,
+                    delay,
+                    ..ByteFaults::default()
+                },
+            )
+        });
+        message.set(Some("applied to every byte this way".into()));
+    };
+    view! {
+        <article class="card" id="sim-uart">
+            <h3>"UART faults"</h3>
+            <label>
+                "Direction "
+                <select
+                    id="sim-dir"
+                    on:change=move |ev| {
+                        dir.set(if event_target_value(&ev) == "up" { Dir::ModemToHost } else { Dir::HostToModem })
+                    }
+                >
+                    <option value="down" selected>"host → modem"</option>
+                    <option value="up">"modem → host"</option>
+                </select>
+            </label>
+            <div class="buttons">
+                <button id="sim-drop" on:click=move |_| inject(Fault::DropByte(dir.get_untracked()))>
+                    "Drop next byte"
+                </button>
+                <button
+                    id="sim-corrupt"
+                    on:click=move |_| inject(Fault::CorruptByte(dir.get_untracked(), 0x10))
+                >
+                    "Corrupt next byte"
+                </button>
+                <button
+                    id="sim-delay"
+                    on:click=move |_| inject(Fault::DelayByte(dir.get_untracked(), 15 * MS))
+                >
+                    "Delay next byte 15 ms"
+                </button>
+            </div>
+            <p class="muted">"At random, for every byte this way:"</p>
+            <label>
+                "drop % "
+                <input size="4" id="sim-p-drop" prop:value=move || drop.get() on:input=move |ev| drop.set(event_target_value(&ev))/>
+            </label>
+            <label>
+                "corrupt % "
+                <input size="4" id="sim-p-corrupt" prop:value=move || corrupt.get() on:input=move |ev| corrupt.set(event_target_value(&ev))/>
+            </label>
+            <label>
+                "delay % "
+                <input size="4" id="sim-p-delay" prop:value=move || delay.get() on:input=move |ev| delay.set(event_target_value(&ev))/>
+            </label>
+            <button id="sim-apply-uart" on:click=apply>"Apply"</button>
+            <p class="muted">{move || message.get()}</p>
+        </article>
+    }
+}
+
+#[component]
+fn LineEventsCard() -> impl IntoView {
+    let c = use_console();
+    view! {
+        <article class="card wide" id="sim-events">
+            <h3>"On the power line"</h3>
+            {move || {
+                let events = c.sim.line_events.get();
+                if events.is_empty() {
+                    view! {
+                        <p class="muted">
+                            "Nothing sent on the line yet. Data requests (PHY/DL/SS) put frames on it; peers echo them."
+                        </p>
+                    }
+                        .into_any()
+                } else {
+                    view! {
+                        <ul class="events">
+                            {events.iter().rev().map(|e| view! { <li>{e.clone()}</li> }).collect_view()}
+                        </ul>
+                    }
+                        .into_any()
+                }
+            }}
+        </article>
+    }
+}

@@ -1,0 +1,283 @@
+//! The traffic inspector: every element both ways, timestamped, decoded
+//! by plm-core, with hex, filters, pause, clear, export and import.
+
+use super::files;
+use super::{seconds, spaced};
+use crate::stores::use_console;
+use crate::traffic::{Entry, Filter, CAPACITY};
+use leptos::prelude::*;
+use plm_core::st7580::code;
+
+/// Rows rendered at most; the log keeps [`CAPACITY`].
+pub const MAX_ROWS: usize = 500;
+
+/// The inspector.
+#[component]
+pub fn TrafficView() -> impl IntoView {
+    let c = use_console();
+    let filter = RwSignal::new(Filter::default());
+    let selected = RwSignal::new(None::<u64>);
+    let message = RwSignal::new(None::<String>);
+    let rows = Memo::new(move |_| {
+        let f = filter.get();
+        let paused = c.traffic.paused_at.get();
+        c.traffic.log.with(|log| {
+            let matching: Vec<&Entry> = log
+                .iter()
+                .filter(|e| paused.is_none_or(|p| e.seq <= p))
+                .filter(|e| f.matches(e))
+                .collect();
+            let total = matching.len();
+            let shown: Vec<Entry> = matching[total.saturating_sub(MAX_ROWS)..]
+                .iter()
+                .map(|e| (*e).clone())
+                .collect();
+            (total, shown)
+        })
+    });
+
+    view! {
+        <div class="toolbar" id="traffic-toolbar">
+            <FilterControls filter=filter/>
+            <PauseButton/>
+            <button
+                id="traffic-clear"
+                on:click=move |_| {
+                    c.traffic.log.update(|l| l.clear());
+                    c.traffic.paused_at.set(None);
+                    selected.set(None);
+                    message.set(None);
+                }
+            >
+                "Clear"
+            </button>
+            <ExportImport message=message/>
+        </div>
+        <p class="counts" id="traffic-counts">
+            {move || {
+                let (total, shown) = rows.with(|(t, s)| (*t, s.len()));
+                c.traffic
+                    .log
+                    .with(|l| {
+                        let mut s = format!("{} elements kept (of {CAPACITY})", l.len());
+                        if l.dropped() > 0 {
+                            s.push_str(&format!(", {} oldest dropped", l.dropped()));
+                        }
+                        s.push_str(&format!("; {total} match the filters"));
+                        if shown < total {
+                            s.push_str(&format!(", the last {shown} shown"));
+                        }
+                        s
+                    })
+            }}
+            {move || c.traffic.paused_at.get().map(|_| " · PAUSED")}
+        </p>
+        {move || message.get().map(|m| view! { <p class="message" id="traffic-message">{m}</p> })}
+        <div class="traffic">
+            <div class="table-wrap">
+                <table class="log" id="traffic-table">
+                    <thead>
+                        <tr>
+                            <th>"#"</th>
+                            <th>"Time"</th>
+                            <th>"Way"</th>
+                            <th>"Element"</th>
+                            <th>"Fields"</th>
+                            <th>"Hex"</th>
+                        </tr>
+                    </thead>
+                    <tbody>
+                        <For
+                            each=move || rows.get().1
+                            key=|e| e.seq
+                            children=move |e| view! { <Row entry=e selected=selected/> }
+                        />
+                    </tbody>
+                </table>
+            </div>
+            <Details selected=selected/>
+        </div>
+    }
+}
+
+#[component]
+fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
+    let commands: Vec<&'static str> = code::ALL.iter().map(|(_, n, _)| *n).collect();
+    view! {
+        <label>
+            "Way "
+            <select
+                id="filter-from"
+                on:change=move |ev| filter.update(|f| f.from = event_target_value(&ev))
+            >
+                <option value="">"both"</option>
+                <option value="host">"host → modem"</option>
+                <option value="modem">"modem → host"</option>
+            </select>
+        </label>
+        <label>
+            "Kind "
+            <select
+                id="filter-kind"
+                on:change=move |ev| filter.update(|f| f.kind = event_target_value(&ev))
+            >
+                <option value="">"all"</option>
+                <option value="frame">"frames"</option>
+                <option value="ack">"ACK"</option>
+                <option value="nak">"NAK"</option>
+                <option value="status">"status messages"</option>
+                <option value="garbage">"garbage"</option>
+            </select>
+        </label>
+        <label>
+            "Command "
+            <select
+                id="filter-command"
+                on:change=move |ev| filter.update(|f| f.command = event_target_value(&ev))
+            >
+                <option value="">"all"</option>
+                {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).collect_view()}
+            </select>
+        </label>
+    }
+}
+
+#[component]
+fn PauseButton() -> impl IntoView {
+    let c = use_console();
+    let paused = c.traffic.paused_at;
+    view! {
+        <button
+            id="traffic-pause"
+            aria-pressed=move || paused.get().is_some().to_string()
+            on:click=move |_| {
+                if paused.get_untracked().is_some() {
+                    paused.set(None);
+                } else {
+                    let last = c.traffic.log.with_untracked(|l| l.next_seq().saturating_sub(1));
+                    paused.set(Some(last));
+                }
+            }
+        >
+            {move || if paused.get().is_some() { "Resume" } else { "Pause" }}
+        </button>
+    }
+}
+
+#[component]
+fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
+    let c = use_console();
+    let export = move |_| {
+        let text = c.traffic.log.with_untracked(|l| l.export());
+        let lines = text.lines().count();
+        match files::download("plm-traffic.jsonl", "application/x-ndjson", &text) {
+            Ok(()) => message.set(Some(format!(
+                "Exported {lines} elements as JSON Lines (plm-traffic.jsonl)."
+            ))),
+            Err(e) => message.set(Some(e)),
+        }
+    };
+    let import = move |ev: leptos::ev::Event| {
+        let Some(file) = files::chosen_file(&ev) else {
+            return;
+        };
+        leptos::task::spawn_local(async move {
+            let name = file.name();
+            let text = match files::read_text(&file).await {
+                Ok(t) => t,
+                Err(e) => {
+                    message.set(Some(e));
+                    return;
+                }
+            };
+            let mut result = None;
+            c.traffic.log.update(|l| result = Some(l.import(&text)));
+            match result {
+                Some(Ok(got)) => {
+                    let last = c
+                        .traffic
+                        .log
+                        .with_untracked(|l| l.next_seq().saturating_sub(1));
+                    c.traffic.paused_at.set(Some(last));
+                    let mut m = format!(
+                        "Imported {} elements from {name}; live traffic is paused (Resume to follow the modem).",
+                        got.count
+                    );
+                    if let Some(first) = got.skipped.first() {
+                        m.push_str(&format!(
+                            " {} lines skipped, e.g. {first}.",
+                            got.skipped.len()
+                        ));
+                    }
+                    message.set(Some(m));
+                }
+                Some(Err(e)) => message.set(Some(format!("Nothing imported from {name}: {e}."))),
+                None => {}
+            }
+        });
+    };
+    view! {
+        <button id="traffic-export" on:click=export>"Export JSONL"</button>
+        <label class="button">
+            "Import JSONL…"
+            <input
+                id="traffic-import"
+                type="file"
+                accept=".jsonl,.json,.txt,application/x-ndjson"
+                on:change=import
+            />
+        </label>
+    }
+}
+
+#[component]
+fn Row(entry: Entry, selected: RwSignal<Option<u64>>) -> impl IntoView {
+    let seq = entry.seq;
+    let from = entry.from().to_string();
+    let way = match from.as_str() {
+        "host" => "→",
+        "modem" => "←",
+        _ => "·",
+    };
+    let bad = entry.decoded.checksum_ok == Some(false)
+        || entry.decoded.kind == "garbage"
+        || entry.decoded.kind == "nak"
+        || entry.decoded.error.is_some();
+    view! {
+        <tr
+            class=format!("from-{from} kind-{}", entry.decoded.kind)
+            class:bad=bad
+            class:selected=move || selected.get() == Some(seq)
+            on:click=move |_| selected.set(Some(seq))
+        >
+            <td class="num">{seq}</td>
+            <td class="time">{entry.at.map(seconds).unwrap_or_else(|| "–".into())}</td>
+            <td class="way" title=from.clone()>{way}</td>
+            <td class="title">{entry.title()}</td>
+            <td class="fields">{entry.summary.clone()}</td>
+            <td class="hex">{spaced(&entry.decoded.hex)}</td>
+        </tr>
+    }
+}
+
+#[component]
+fn Details(selected: RwSignal<Option<u64>>) -> impl IntoView {
+    let c = use_console();
+    let json = move || {
+        let seq = selected.get()?;
+        c.traffic.log.with(|l| {
+            let e = l.get(seq)?;
+            let v: serde_json::Value = serde_json::from_str(&e.to_json_line()).ok()?;
+            serde_json::to_string_pretty(&v).ok()
+        })
+    };
+    view! {
+        <aside class="details" id="traffic-details">
+            <h3>"Element"</h3>
+            {move || match json() {
+                Some(j) => view! { <pre>{j}</pre> }.into_any(),
+                None => view! { <p class="muted">"Click a row to see every field."</p> }.into_any(),
+            }}
+        </aside>
+    }
+}

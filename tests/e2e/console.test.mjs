@@ -1,0 +1,324 @@
+// Browser end-to-end journeys of PLM Console against the simulated modem.
+//
+// `cargo xtask test` builds the release console into dist/ first; this
+// file serves dist/ itself (node:http), drives Debian's Chromium with
+// playwright-core, and saves a screenshot of every view into artifacts/.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import http from 'node:http';
+import fs from 'node:fs/promises';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const dist = path.resolve(here, '../../dist');
+const artifacts = path.join(here, 'artifacts');
+
+const TYPES = {
+  '.html': 'text/html; charset=utf-8',
+  '.js': 'text/javascript',
+  '.wasm': 'application/wasm',
+  '.css': 'text/css',
+  '.json': 'application/json',
+  '.svg': 'image/svg+xml',
+  '.png': 'image/png',
+  '.webmanifest': 'application/manifest+json',
+};
+
+let server;
+let base;
+let browser;
+
+/** Serves dist/ on 127.0.0.1 (a secure context, as WebSerial needs). */
+function serve() {
+  return new Promise((resolve) => {
+    const s = http.createServer(async (req, res) => {
+      const url = new URL(req.url, 'http://127.0.0.1');
+      let file = path.normalize(path.join(dist, decodeURIComponent(url.pathname)));
+      if (!file.startsWith(dist)) {
+        res.writeHead(403).end();
+        return;
+      }
+      if (url.pathname.endsWith('/')) file = path.join(file, 'index.html');
+      try {
+        const body = await fs.readFile(file);
+        const type = TYPES[path.extname(file)] ?? 'application/octet-stream';
+        res.writeHead(200, { 'content-type': type, 'cache-control': 'no-store' }).end(body);
+      } catch {
+        res.writeHead(404).end('not found');
+      }
+    });
+    s.listen(0, '127.0.0.1', () => resolve(s));
+  });
+}
+
+before(async () => {
+  await fs.access(path.join(dist, 'index.html')).catch(() => {
+    throw new Error(`no console build in ${dist}: run \`cargo xtask dist\` first`);
+  });
+  await fs.mkdir(artifacts, { recursive: true });
+  server = await serve();
+  base = `http://127.0.0.1:${server.address().port}/`;
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: [
+      '--headless',
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-quic',
+      '--no-first-run',
+      '--disable-background-networking',
+      '--disable-component-update',
+      '--disable-sync',
+    ],
+  });
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((r) => (server ? server.close(r) : r()));
+});
+
+/** A fresh page (and so a fresh simulated modem), failing on page errors. */
+async function open(t, hash = '') {
+  const context = await browser.newContext({
+    acceptDownloads: true,
+    viewport: { width: 1400, height: 900 },
+  });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+  });
+  t.after(async () => {
+    await context.close();
+    assert.deepEqual(errors, [], 'no errors in the page');
+  });
+  await page.goto(base + hash);
+  await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+  return page;
+}
+
+async function tab(page, slug) {
+  await page.click(`#tab-${slug}`);
+  await page.locator(`#view-${slug}`).waitFor({ state: 'visible' });
+}
+
+async function shot(page, name) {
+  await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: false });
+}
+
+/** Titles of the traffic rows shown (Element column). */
+async function titles(page) {
+  return page.locator('#traffic-table tbody tr td.title').allTextContents();
+}
+
+test('the page opens connected to the simulated modem, which reports its reset', async (t) => {
+  const page = await open(t);
+  assert.match(await page.textContent('#conn-state'), /Connected/);
+  assert.match(await page.textContent('#conn-port'), /simulated/);
+  await page
+    .locator('#traffic-table tbody tr', { hasText: 'BIO_ResetIndication' })
+    .first()
+    .waitFor();
+  await page.locator('#traffic-table tbody tr', { hasText: 'BIO_ResetIndication' }).first().click();
+  assert.match(await page.textContent('#traffic-details pre'), /"reset_cause": "Power-on reset"|"reset_cause"/);
+  await shot(page, 'traffic');
+});
+
+test('ping shows the PingConfirm and its round-trip time', async (t) => {
+  const page = await open(t, '#diagnostics');
+  await page.fill('#ping-payload', '01 02 03 04 05');
+  await page.click('#ping-send');
+  const result = page.locator('#ping-result');
+  await result.filter({ hasText: 'PingConfirm' }).waitFor();
+  assert.match(
+    await result.textContent(),
+    /^PingConfirm in \d+\.\d ms \(payload echoed intact\): 01 02 03 04 05$/,
+  );
+  // Live status bits came with the exchange.
+  await page.locator('#status table').waitFor();
+  assert.match(await page.textContent('#status'), /Active layer/);
+  await page.click('#firmware-read');
+  await page.locator('#firmware-value', { hasText: '00420097h' }).waitFor();
+  await page.click('#counters-06 [data-action=read]');
+  await page.locator('#counters-06 table').waitFor();
+  await shot(page, 'diagnostics');
+  await tab(page, 'traffic');
+  const seen = await titles(page);
+  assert.ok(seen.includes('PingRequest') && seen.includes('PingConfirm'), seen.join(', '));
+});
+
+test('read, change, write and read back the PHY configuration', async (t) => {
+  const page = await open(t, '#modem');
+  const card = page.locator('#mib-01');
+  const status = card.locator('[data-role=status]');
+  await card.locator('[data-action=read]').click();
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
+  const freq = card.locator('input[name=high_frequency]');
+  assert.equal(await freq.inputValue(), '86000');
+  assert.equal(await card.locator('[data-role=diff]').textContent(), 'equal to the factory default');
+
+  await freq.fill('110000');
+  await card.locator('input[name=tx_gain]').fill('20');
+  await card.locator('[data-action=write]').click();
+  await status.filter({ hasText: 'written and read back: the modem has it' }).waitFor();
+
+  // Read it back once more, by hand.
+  await card.locator('[data-action=read]').click();
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
+  assert.equal(await freq.inputValue(), '110000');
+  assert.equal(await card.locator('input[name=tx_gain]').inputValue(), '20');
+  assert.match(
+    await card.locator('[data-role=diff]').textContent(),
+    /2 field\(s\) differ from the factory default: High frequency, TX gain/,
+  );
+  await shot(page, 'modem');
+
+  await tab(page, 'traffic');
+  await page.selectOption('#filter-command', 'MIB_WriteRequest');
+  const rows = page.locator('#traffic-table tbody tr');
+  assert.equal(await rows.count(), 1);
+  assert.match(await rows.first().textContent(), /high_frequency=110000/);
+});
+
+test('a profile saved to a file and loaded back restores the configuration', async (t) => {
+  const page = await open(t, '#modem');
+  await page.click('#mib-read-all');
+  await page.locator('#mib-progress', { hasText: 'Read all 11 objects.' }).waitFor();
+  const card = page.locator('#mib-01');
+  const freq = card.locator('input[name=high_frequency]');
+  await freq.fill('110000');
+  await card.locator('[data-action=write]').click();
+  await card.locator('[data-role=status]', { hasText: 'written and read back' }).waitFor();
+
+  const [download] = await Promise.all([
+    page.waitForEvent('download'),
+    page.click('#profile-save'),
+  ]);
+  const file = path.join(artifacts, 'plm-profile.json');
+  await download.saveAs(file);
+  assert.match(await page.textContent('#profile-message'), /Saved the 4 writable objects/);
+  const profile = JSON.parse(await fs.readFile(file, 'utf8'));
+  assert.equal(profile.objects['01'].slice(0, 6), '01adb0');
+
+  // A power-on reset brings back the factory MIB (UM0932 Table 19).
+  await tab(page, 'simulator');
+  await page.click('#sim-reset');
+  await tab(page, 'modem');
+  await card.locator('[data-action=read]').click();
+  await card.locator('[data-role=status]', { hasText: 'read from the modem' }).waitFor();
+  assert.equal(await freq.inputValue(), '86000');
+
+  await page.setInputFiles('#profile-load', file);
+  await page
+    .locator('#profile-message', { hasText: 'Profile applied: 4 objects written and read back.' })
+    .waitFor();
+  assert.equal(await freq.inputValue(), '110000');
+});
+
+test('an out-of-range frequency is refused in the form and nothing is sent', async (t) => {
+  const page = await open(t, '#modem');
+  const card = page.locator('#mib-01');
+  await card.locator('input[name=high_frequency]').fill('200000');
+  await card.locator('[data-action=write]').click();
+  const reason = card.locator('tr[data-field=high_frequency] [data-role=problem]');
+  await reason.filter({ hasText: '200000 is out of range 3000..=148500 Hz' }).waitFor();
+  assert.ok(await reason.isVisible());
+  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
+  await shot(page, 'modem-refused');
+  // Give a wrongly sent request time to show up, then look for it.
+  await page.waitForTimeout(300);
+  await tab(page, 'traffic');
+  const all = await titles(page);
+  assert.ok(all.length > 0, 'the log has the reset indication');
+  assert.ok(!all.includes('MIB_WriteRequest'), all.join(', '));
+});
+
+test('the traffic log exports to JSON Lines and imports again', async (t) => {
+  const page = await open(t, '#diagnostics');
+  await page.click('#ping-send');
+  await page.locator('#ping-result', { hasText: 'PingConfirm' }).waitFor();
+  await tab(page, 'traffic');
+  await page.click('#traffic-pause');
+  const before = await titles(page);
+  const [download] = await Promise.all([
+    page.waitForEvent('download'),
+    page.click('#traffic-export'),
+  ]);
+  assert.equal(download.suggestedFilename(), 'plm-traffic.jsonl');
+  const file = path.join(artifacts, 'plm-traffic.jsonl');
+  await download.saveAs(file);
+  const lines = (await fs.readFile(file, 'utf8')).trim().split('\n');
+  assert.equal(lines.length, before.length);
+  for (const line of lines) {
+    const e = JSON.parse(line);
+    assert.equal(typeof e.time_us, 'number');
+    assert.ok(['frame', 'ack', 'nak', 'status', 'garbage'].includes(e.kind), line);
+    assert.match(e.hex, /^([0-9a-f]{2})+$/);
+  }
+  const ping = lines.map((l) => JSON.parse(l)).find((e) => e.command === 'PingRequest');
+  assert.equal(ping.from, 'host');
+  assert.equal(ping.fields.data, '504c4d21');
+
+  await page.click('#traffic-clear');
+  assert.equal(await page.locator('#traffic-table tbody tr').count(), 0);
+  await page.setInputFiles('#traffic-import', file);
+  await page.locator('#traffic-message', { hasText: `Imported ${lines.length} elements` }).waitFor();
+  assert.deepEqual(await titles(page), before);
+  await shot(page, 'traffic-imported');
+});
+
+test('the simulator unplugs the cable, the console says so, and recovers', async (t) => {
+  const page = await open(t, '#simulator');
+  await page.selectOption('#sim-nodes', '2');
+  await page.click('#sim-apply-topology');
+  await page.locator('#conn-port', { hasText: '1 echoing peer' }).waitFor();
+  await page.click('#sim-plug');
+  await page.locator('#conn-state:not(.ok)').waitFor();
+  await shot(page, 'simulator');
+  await tab(page, 'diagnostics');
+  await page.click('#ping-send');
+  await page.locator('#ping-result', { hasText: 'unplugged' }).waitFor();
+  await tab(page, 'simulator');
+  await page.click('#sim-plug');
+  await page.locator('#conn-state.ok').waitFor();
+  await tab(page, 'diagnostics');
+  await page.click('#ping-send');
+  await page.locator('#ping-result', { hasText: 'PingConfirm' }).waitFor();
+});
+
+test('a DL frame to an echoing peer comes back as a DL_DataIndication', async (t) => {
+  const page = await open(t, '#simulator');
+  await page.selectOption('#sim-nodes', '2');
+  await page.click('#sim-apply-topology');
+  await page.locator('#conn-port', { hasText: '1 echoing peer' }).waitFor();
+  await tab(page, 'data');
+
+  // The form refuses what the modem would refuse, and sends nothing.
+  await page.selectOption('#data-frequency', 'custom');
+  await page.fill('#data-custom-hz', '200000');
+  await page.click('#data-send');
+  await page
+    .locator('#data-result', { hasText: 'nothing sent: TX frequency: 200000 is out of range' })
+    .waitFor();
+  await page.selectOption('#data-frequency', 'high');
+
+  await page.fill('#data-payload', 'hello street');
+  await page.click('#data-send');
+  await page.locator('#data-result', { hasText: 'DL_DataConfirm after' }).waitFor();
+  const row = page.locator('#indications-table tbody tr', { hasText: 'DL_DataIndication' });
+  await row.first().waitFor({ timeout: 5_000 });
+  assert.match(await row.first().textContent(), /68 65 6c 6c 6f 20 73 74 72 65 65 74/);
+  await shot(page, 'data');
+  await tab(page, 'simulator');
+  await page.locator('#sim-events li', { hasText: 'node 1 hears node 0' }).first().waitFor();
+  await shot(page, 'simulator-line');
+  await tab(page, 'traffic');
+  const seen = await titles(page);
+  assert.ok(!seen.includes('DL_DataError'), seen.join(', '));
+  assert.equal(seen.filter((s) => s === 'DL_DataRequest').length, 1, 'only the valid request was sent');
+});
