@@ -1,6 +1,7 @@
 //! `cargo xtask bench`: the performance figures of DESIGN.md, measured by
 //! programs that print their own results (never by timed tests).
 
+use crate::serve;
 use crate::util::{root, run_steps, Cmd, Result, Step};
 
 /// One benchmark: a program that prints its figures, and the source file
@@ -10,6 +11,9 @@ struct Bench {
     /// Relative to the workspace root; any one of them will do.
     sources: &'static [&'static str],
     cmd: Cmd,
+    /// Whether it measures the release console in `dist/`, which is then
+    /// built first (once).
+    needs_dist: bool,
 }
 
 /// Append new benchmarks here (link latency, command rate, RFU, size...).
@@ -30,6 +34,7 @@ fn benches() -> Vec<Bench> {
                 "--example",
                 "bench_decode",
             ]),
+            needs_dist: false,
         },
         Bench {
             name: "simulator speed and MIB-read rate (native)",
@@ -43,9 +48,19 @@ fn benches() -> Vec<Bench> {
                 "--example",
                 "bench_sim",
             ]),
+            needs_dist: false,
+        },
+        Bench {
+            name: "console in Chromium: ACK latency, MIB-read rate, size",
+            sources: &["tests/e2e/bench.mjs"],
+            cmd: Cmd::new("node").args(["tests/e2e/bench.mjs"]),
+            needs_dist: true,
         },
     ]
 }
+
+/// How the release console is built into `dist/`.
+const DIST: &str = "cargo xtask dist";
 
 /// Runs every benchmark; all must exist.
 pub fn run() -> Result {
@@ -68,9 +83,16 @@ pub fn run() -> Result {
         "bench: {} benchmark(s); each prints its own figures",
         benches.len()
     );
-    let steps: Vec<Step> = benches
-        .into_iter()
-        .map(|b| Step::cmd(b.name, b.cmd))
-        .collect();
+    let mut steps = Vec::new();
+    for b in benches {
+        if b.needs_dist && !steps.iter().any(|s: &Step| s.rerun == DIST) {
+            steps.push(Step::new(
+                "console release build (dist/)",
+                DIST,
+                serve::dist,
+            ));
+        }
+        steps.push(Step::cmd(b.name, b.cmd));
+    }
     run_steps("bench", &steps, false)
 }

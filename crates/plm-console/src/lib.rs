@@ -6,6 +6,7 @@
 //! - [`traffic`]: the inspector's bounded, filterable, exportable log.
 //! - [`mibform`]: MIB forms read from plm-core's declarative description.
 //! - [`app`], [`stores`], [`views`]: the Leptos application.
+//! - [`bench_hook`]: `window.plmBench`, for `cargo xtask bench`.
 
 pub mod mibform;
 pub mod session;
@@ -13,5 +14,6 @@ pub mod traffic;
 pub mod transport;
 
 pub mod app;
+pub mod bench_hook;
 pub mod stores;
 pub mod views;

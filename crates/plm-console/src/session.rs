@@ -14,6 +14,9 @@
 //!   ACK the modem may have executed it twice (protocol notes, "Known
 //!   limits"); a second answer of the same kind within [`DUPLICATE_GRACE`]
 //!   is reported as such and never taken for the next request's.
+//! - Every modem frame the engine ACKs adds a sample to the ACK latency
+//!   ([`AckLatency`]): from the arrival of the frame's last byte to the
+//!   ACK written, against T_ACK (UM0932 3.2.8).
 
 use crate::transport::{LinkState, Transport};
 use plm_core::decode::{Decoded, Decoder};
@@ -34,6 +37,8 @@ pub const MAX_CATCH_UP: Duration = 100 * MS;
 /// How long after its answer a request repeated for want of an ACK may
 /// still see a second answer.
 pub const DUPLICATE_GRACE: Duration = 200 * MS;
+/// ACK latencies kept for the percentiles (the most recent ones).
+pub const ACK_SAMPLES: usize = 1_000;
 
 /// What became of a request.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -95,6 +100,77 @@ pub enum Note {
     Timeouts(Timeouts),
 }
 
+/// The spread of a set of durations, µs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Spread {
+    /// Median.
+    pub p50: Duration,
+    /// 99th percentile (nearest rank).
+    pub p99: Duration,
+    /// Longest.
+    pub max: Duration,
+}
+
+impl Spread {
+    fn of(mut samples: Vec<Duration>) -> Spread {
+        samples.sort_unstable();
+        // Nearest rank: the smallest value with at least p of the samples
+        // at or below it.
+        let rank = |p: usize| samples[(samples.len() * p).div_ceil(100).max(1) - 1];
+        match samples.last() {
+            None => Spread::default(),
+            Some(&max) => Spread {
+                p50: rank(50),
+                p99: rank(99),
+                max,
+            },
+        }
+    }
+}
+
+/// How quickly the host ACKs the modem's frames: from the arrival of a
+/// frame's last byte to the ACK written (UM0932 3.2.8: within T_ACK),
+/// over the last [`ACK_SAMPLES`] frames.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AckLatency {
+    /// Frames ACKed since connecting.
+    pub count: u64,
+    /// On the transport's clock: what the modem saw. The session steps
+    /// the transport's time in slices of [`SLICE`], so this stays within
+    /// a slice; the simulated modem's virtual time waits for the page.
+    pub link: Spread,
+    /// On the page's clock: how long after the byte arrived the page got
+    /// round to writing the ACK. It includes the page's timer period and
+    /// any stall, which a real modem would see as they are.
+    pub page: Spread,
+}
+
+/// The raw ACK latencies, bounded.
+#[derive(Debug, Default)]
+struct AckTimes {
+    count: u64,
+    /// (transport's clock, page's clock), oldest first.
+    samples: VecDeque<(Duration, Duration)>,
+}
+
+impl AckTimes {
+    fn record(&mut self, link: Duration, page: Duration) {
+        if self.samples.len() == ACK_SAMPLES {
+            self.samples.pop_front();
+        }
+        self.samples.push_back((link, page));
+        self.count += 1;
+    }
+
+    fn stats(&self) -> AckLatency {
+        AckLatency {
+            count: self.count,
+            link: Spread::of(self.samples.iter().map(|s| s.0).collect()),
+            page: Spread::of(self.samples.iter().map(|s| s.1).collect()),
+        }
+    }
+}
+
 /// What a tick produced: notes for the stores and replies to call, both to
 /// be handled once the session is no longer borrowed.
 #[derive(Default)]
@@ -141,6 +217,9 @@ pub struct Session {
     duplicate_of: Option<(u8, Instant)>,
     /// Page time (µs) at which the transport's clock read 0.
     origin: Option<f64>,
+    /// The page's clock at the current tick, on the transport's clock.
+    page_now: Instant,
+    ack_times: AckTimes,
     out: Tick,
 }
 
@@ -156,6 +235,8 @@ impl Session {
             active: None,
             duplicate_of: None,
             origin: None,
+            page_now: 0,
+            ack_times: AckTimes::default(),
             out: Tick::default(),
         }
     }
@@ -193,6 +274,7 @@ impl Session {
         self.transport = transport;
         self.origin = None;
         self.duplicate_of = None;
+        self.ack_times = AckTimes::default();
         self.out.notes.push(Note::TReq(false));
         self.out
             .notes
@@ -214,6 +296,11 @@ impl Session {
     /// The host-interface timeouts in use.
     pub fn timeouts(&self) -> Timeouts {
         self.host.config().timeouts
+    }
+
+    /// How quickly the host has ACKed the modem's frames since connecting.
+    pub fn ack_latency(&self) -> AckLatency {
+        self.ack_times.stats()
     }
 
     /// Requests not yet answered (the one outstanding and those queued).
@@ -244,6 +331,7 @@ impl Session {
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
             let origin = *self.origin.get_or_insert(page_us - start as f64);
             let mut target = (page_us - origin).max(0.0) as Instant;
+            self.page_now = target;
             if target > start + MAX_CATCH_UP {
                 target = start + MAX_CATCH_UP;
                 self.origin = Some(page_us - target as f64);
@@ -367,7 +455,19 @@ impl Session {
                 }
                 self.traffic(now, &el, "modem");
             }
-            Event::Sent(el) => self.traffic(now, &el, "host"),
+            Event::Sent(el) => {
+                if matches!(el, Element::Ack) {
+                    // `now` is the arrival of the frame's last byte: the
+                    // engine ACKs in the `handle_rx` of that byte, and the
+                    // ACK has just been written.
+                    let written = self.now();
+                    self.ack_times.record(
+                        written.saturating_sub(now),
+                        self.page_now.max(written).saturating_sub(now),
+                    );
+                }
+                self.traffic(now, &el, "host")
+            }
             Event::Frame(f) => self.on_frame(now, f),
             Event::Repeat(_) => {}
             Event::Delivered(t) => {
@@ -654,6 +754,55 @@ mod tests {
                 ..
             }
         )));
+    }
+
+    #[test]
+    fn every_frame_acked_is_timed_on_both_clocks() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (0.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes);
+        let seen = Seen::default();
+        s.request(Command::PingRequest { data: vec![9] }, reply(&seen));
+        run(&mut s, &mut page, 100, &mut notes);
+        let acks = notes
+            .iter()
+            .filter(|n| matches!(n, Note::Traffic { decoded, .. } if decoded.from.as_deref() == Some("host") && decoded.kind == "ack"))
+            .count();
+        let l = s.ack_latency();
+        // The BIO_ResetIndication at boot and the PingConfirm.
+        assert_eq!((l.count, acks), (2, 2), "{l:?}");
+        assert!(l.link.max <= SLICE, "{l:?}");
+        // Ticks every 4 ms: the page got to each byte within a tick.
+        assert!(l.page.max <= 4 * MS && l.page.p50 >= l.link.p50, "{l:?}");
+        // A page stalled for 30 ms shows on the page's clock only.
+        s.request(Command::PingRequest { data: vec![9] }, reply(&seen));
+        page += 30_000.0;
+        let _ = s.tick(page);
+        let l = s.ack_latency();
+        assert_eq!(l.count, 3);
+        assert!(l.link.max <= SLICE, "{l:?}");
+        assert!(l.page.max > 10 * MS && l.page.max < 30 * MS, "{l:?}");
+        s.replace_transport(None);
+        assert_eq!(s.ack_latency(), AckLatency::default());
+    }
+
+    #[test]
+    fn ack_latency_percentiles_cover_the_most_recent_samples() {
+        assert_eq!(Spread::of(vec![]), Spread::default());
+        let one = Spread::of(vec![7]);
+        assert_eq!((one.p50, one.p99, one.max), (7, 7, 7));
+        let hundred = Spread::of((1..=100).rev().collect());
+        assert_eq!((hundred.p50, hundred.p99, hundred.max), (50, 99, 100));
+        let mut t = AckTimes::default();
+        for i in 0..ACK_SAMPLES as u64 + 500 {
+            t.record(i, 2 * i);
+        }
+        let l = t.stats();
+        assert_eq!(l.count, ACK_SAMPLES as u64 + 500);
+        assert_eq!(t.samples.len(), ACK_SAMPLES);
+        assert_eq!(l.link.max, ACK_SAMPLES as u64 + 499);
+        assert_eq!(l.link.p50, 500 + ACK_SAMPLES as u64 / 2 - 1);
+        assert_eq!(l.page.max, 2 * l.link.max);
     }
 
     #[test]

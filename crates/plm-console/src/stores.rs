@@ -175,6 +175,19 @@ impl Console {
         self.refresh();
     }
 
+    /// Connects over `transport` (a WebSerial port the port chooser opened,
+    /// `views::serial_port`).
+    pub fn connect_transport(&self, transport: Box<dyn crate::transport::Transport>) {
+        self.session()
+            .borrow_mut()
+            .replace_transport(Some(transport));
+        self.modem.mib.set(BTreeMap::new());
+        self.modem.status.set(None);
+        self.conn.retries.set(0);
+        self.conn.last_problem.set(None);
+        self.refresh();
+    }
+
     /// Closes the connection.
     pub fn disconnect(&self) {
         self.session().borrow_mut().replace_transport(None);
@@ -229,6 +242,11 @@ impl Console {
             }
         }
         self.refresh();
+    }
+
+    /// How quickly the host has ACKed the modem's frames since connecting.
+    pub fn ack_latency(&self) -> crate::session::AckLatency {
+        self.session().borrow().ack_latency()
     }
 
     /// Lets time pass up to the page's clock: called by the page's timer.

@@ -7,6 +7,9 @@
 //! WebSerial to real hardware (not built yet).
 
 pub mod sim;
+/// WebSerial exists only in the browser (web-sys unstable APIs, wasm32).
+#[cfg(target_arch = "wasm32")]
+pub mod webserial;
 
 use plm_core::time::Instant;
 use plm_sim::{Fault, LineConfig, LineEvent};

@@ -49,6 +49,7 @@ pub fn ConnectionBar() -> impl IntoView {
                     <option value="serial" disabled>{serial_note}</option>
                 </select>
             </label>
+            <crate::views::serial_port::SerialPort/>
             <span class="item" id="conn-port" title="Port">{move || conn.port.get()}</span>
             <label>
                 "Baud "

@@ -1,23 +1,28 @@
 //! Diagnostics: ping with round-trip time, the live status message bits,
-//! firmware version, reset with the last reset cause, and the counters of
-//! MIB 06h-08h with erase.
+//! the host's ACK latency, firmware version, reset with the last reset
+//! cause, and the counters of MIB 06h-08h with erase.
 
 use super::{millis, seconds, spaced};
-use crate::session::Outcome;
+use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
 use leptos::prelude::*;
 use plm_core::field::Field;
 use plm_core::st7580::fields::{reset_data, status};
 use plm_core::st7580::mib::{index, object};
 use plm_core::st7580::Command;
+use plm_core::time::MS;
 
 /// The view.
 #[component]
 pub fn DiagnosticsView() -> impl IntoView {
+    // This view is mounted once, for the page's life (every view stays
+    // mounted): a good place for the benchmark's hook.
+    crate::bench_hook::install(use_console());
     view! {
         <div class="cards">
             <PingCard/>
             <StatusCard/>
+            <AckLatencyCard/>
             <FirmwareCard/>
             <ResetCard/>
             <CountersCard/>
@@ -146,6 +151,64 @@ fn StatusCard() -> impl IntoView {
                     <table class="kv">{field_rows(status::LAYOUT, vec![byte])}</table>
                 }
                 .into_any(),
+            }}
+        </article>
+    }
+}
+
+/// The host's ACK latency (UM0932 3.2.8: within T_ACK of a frame's end).
+#[component]
+fn AckLatencyCard() -> impl IntoView {
+    let c = use_console();
+    // Recomputed when traffic comes: every ACK goes to the traffic log.
+    let latency = Memo::new(move |_| {
+        c.traffic.log.track();
+        c.conn.port.track();
+        c.ack_latency()
+    });
+    let simulated = move || c.conn.kind.get() == "Simulated";
+    view! {
+        <article class="card" id="ack-latency">
+            <h3>"ACK latency"</h3>
+            <p class="muted">
+                "From the last byte of each modem frame to the host's ACK (UM0932 3.2.8), on the page's clock: it includes the page's timer period (about 4 ms) and any stall of the page."
+            </p>
+            {move || {
+                let l = latency.get();
+                let t_ack = c.conn.timeouts.get().t_ack;
+                if l.count == 0 {
+                    return view! { <p class="muted" id="ack-latency-value">"No frame from the modem yet."</p> }
+                        .into_any();
+                }
+                let p = l.page;
+                let line = format!(
+                    "ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)",
+                    millis(p.p50),
+                    millis(p.p99),
+                    millis(p.max),
+                    t_ack / MS
+                );
+                let late = p.max > t_ack;
+                let frames = if l.count as usize > ACK_SAMPLES {
+                    format!("Over the last {ACK_SAMPLES} of {} frames ACKed since connecting.", l.count)
+                } else {
+                    format!("{} frame(s) ACKed since connecting.", l.count)
+                };
+                let link = simulated()
+                    .then(|| {
+                        format!(
+                            "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
+                            millis(l.link.p99),
+                            millis(l.link.max)
+                        )
+                    });
+                view! {
+                    <p id="ack-latency-value" class:problem=late>
+                        {line}
+                    </p>
+                    <p class="muted">{frames} " " {link}</p>
+                }
+                .into_any()
             }}
         </article>
     }

@@ -7,6 +7,7 @@ pub mod data;
 pub mod diagnostics;
 pub mod files;
 pub mod modem;
+pub mod serial_port;
 pub mod simulator;
 pub mod traffic;
 

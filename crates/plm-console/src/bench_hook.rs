@@ -1,0 +1,151 @@
+//! `window.plmBench`: the hook `tests/e2e/bench.mjs` (`cargo xtask bench`)
+//! drives the console through, so that it measures the session rather
+//! than a script clicking buttons. It only does what the views do (change
+//! the baud rate, read a MIB object) through the same [`Console`], so it
+//! is harmless on any page and always compiled.
+//!
+//! - `plmBench.setBaud(baud)`: as the connection bar's baud select (UM0932
+//!   Table 5 rates only); returns the baud rate in use.
+//! - `plmBench.mibReads(n, index, chained)`: `n` MIB_ReadRequests of
+//!   `index`, all queued at once (the session sends each as soon as the
+//!   previous one is answered) or, `chained`, each sent from the previous
+//!   one's reply, as a view would. A Promise of `{reads, failed,
+//!   firstError, dataLen, elapsedMs}` on the page's clock.
+//! - `plmBench.ackLatency()`: [`crate::session::AckLatency`] in ms, with
+//!   the T_ACK in use: `{count, link: {p50, p99, max}, page: {…}, tAck}`.
+
+use crate::session::{Outcome, Spread};
+use crate::stores::{page_now_us, refusal, Console};
+use js_sys::{Function, Object, Promise, Reflect, JSON};
+use leptos::prelude::GetUntracked;
+use plm_core::st7580::Command;
+use plm_core::time::Duration;
+use serde_json::json;
+use std::cell::RefCell;
+use std::rc::Rc;
+use wasm_bindgen::prelude::*;
+
+/// Puts `window.plmBench` on the page for the console `c`.
+pub fn install(c: Console) {
+    let Some(window) = web_sys::window() else {
+        return;
+    };
+    let hook = Object::new();
+    let set_baud = Closure::<dyn Fn(u32) -> u32>::new(move |baud: u32| {
+        if plm_sim::BAUD_RATES.contains(&baud) {
+            c.set_baud(baud);
+        }
+        c.conn.baud.get_untracked()
+    });
+    let mib_reads = Closure::<dyn Fn(u32, u8, bool) -> Promise>::new(
+        move |n: u32, index: u8, chained: bool| mib_reads(c, n, index, chained),
+    );
+    let ack_latency = Closure::<dyn Fn() -> JsValue>::new(move || ack_latency(c));
+    let _ = Reflect::set(&hook, &"setBaud".into(), set_baud.as_ref());
+    let _ = Reflect::set(&hook, &"mibReads".into(), mib_reads.as_ref());
+    let _ = Reflect::set(&hook, &"ackLatency".into(), ack_latency.as_ref());
+    // The page keeps them for its whole life.
+    set_baud.forget();
+    mib_reads.forget();
+    ack_latency.forget();
+    let _ = Reflect::set(&window, &"plmBench".into(), &hook);
+}
+
+fn ms(us: Duration) -> f64 {
+    us as f64 / 1_000.0
+}
+
+fn spread(s: Spread) -> serde_json::Value {
+    json!({ "p50": ms(s.p50), "p99": ms(s.p99), "max": ms(s.max) })
+}
+
+fn to_js(value: serde_json::Value) -> JsValue {
+    JSON::parse(&value.to_string()).unwrap_or(JsValue::NULL)
+}
+
+fn ack_latency(c: Console) -> JsValue {
+    let l = c.ack_latency();
+    to_js(json!({
+        "count": l.count,
+        "link": spread(l.link),
+        "page": spread(l.page),
+        "tAck": ms(c.conn.timeouts.get_untracked().t_ack),
+    }))
+}
+
+/// One run of `mibReads`.
+struct Run {
+    n: u32,
+    done: u32,
+    failed: u32,
+    first_error: Option<String>,
+    data_len: usize,
+    started: f64,
+    resolve: Function,
+}
+
+fn mib_reads(c: Console, n: u32, index: u8, chained: bool) -> Promise {
+    Promise::new(&mut |resolve, _reject| {
+        let run = Rc::new(RefCell::new(Run {
+            n,
+            done: 0,
+            failed: 0,
+            first_error: None,
+            data_len: 0,
+            started: page_now_us(),
+            resolve,
+        }));
+        if n == 0 {
+            finish(&run.borrow());
+        } else if chained {
+            read(c, run, index, true);
+        } else {
+            for _ in 0..n {
+                read(c, run.clone(), index, false);
+            }
+        }
+    })
+}
+
+fn read(c: Console, run: Rc<RefCell<Run>>, index: u8, chained: bool) {
+    c.request(Command::MibReadRequest { index }, move |o| {
+        let more = {
+            let mut r = run.borrow_mut();
+            r.done += 1;
+            match o {
+                Outcome::Answer {
+                    command: Command::MibReadConfirm { data },
+                    ..
+                } => r.data_len = data.len(),
+                Outcome::Answer { command, .. } => {
+                    r.failed += 1;
+                    let why = refusal(&command).unwrap_or_else(|| format!("{command:?}"));
+                    r.first_error.get_or_insert(why);
+                }
+                Outcome::Failed(why) => {
+                    r.failed += 1;
+                    r.first_error.get_or_insert(why);
+                }
+            }
+            if r.done == r.n {
+                finish(&r);
+            }
+            chained && r.done < r.n
+        };
+        // The borrow is over: a failure may be replied at once.
+        if more {
+            read(c, run, index, true);
+        }
+    });
+}
+
+fn finish(r: &Run) {
+    let result = json!({
+        "reads": r.done,
+        "failed": r.failed,
+        "firstError": r.first_error,
+        "dataLen": r.data_len,
+        "elapsedMs": (page_now_us() - r.started) / 1_000.0,
+    });
+    let _ = r.resolve.call1(&JsValue::NULL, &to_js(result));
+}

@@ -1,0 +1,206 @@
+// The console's figures of DESIGN.md "Performance", measured in Chromium
+// against the simulated modem: `cargo xtask bench` runs this after
+// building dist/ (not part of `npm test`: benchmarks are never timed tests).
+//
+//   node tests/e2e/bench.mjs          (dist/ must exist: `cargo xtask dist`)
+//
+// - ACK latency p50/p99: from the last byte of a modem frame to the host's
+//   ACK (UM0932 3.2.8), against T_ACK, as the session records it.
+// - MIB-read round trips per second at 57600 baud versus the wire-time
+//   limit, computed from the bytes one exchange puts on the wire as the
+//   console's own traffic log shows them.
+// - gzip -9 sizes of the wasm, JS and CSS in dist/.
+//
+// The page is driven through `window.plmBench` (crates/plm-console/src/
+// bench_hook.rs), so the figures are the session's, not a script's clicks.
+// PLM_DIST (another build directory), PLM_BENCH_READS (default 300) and
+// CHROMIUM override the defaults.
+
+import http from 'node:http';
+import fs from 'node:fs/promises';
+import path from 'node:path';
+import zlib from 'node:zlib';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const dist = path.resolve(process.env.PLM_DIST ?? path.join(here, '../../dist'));
+const artifacts = path.join(here, 'artifacts');
+const READS = Number(process.env.PLM_BENCH_READS ?? 300);
+const WARM_UP = 20;
+const BAUD = 57_600;
+/** UART 8N1: start bit, 8 data bits, stop bit (UM0932 2.1). */
+const BITS_PER_BYTE = 10;
+/** MIB object read: 0Ah, firmware version (UM0932 4.2.10). */
+const MIB_INDEX = 0x0a;
+
+const TYPES = {
+  '.html': 'text/html; charset=utf-8',
+  '.js': 'text/javascript',
+  '.wasm': 'application/wasm',
+  '.css': 'text/css',
+  '.json': 'application/json',
+  '.svg': 'image/svg+xml',
+  '.png': 'image/png',
+  '.webmanifest': 'application/manifest+json',
+};
+
+/** Serves `dist` on 127.0.0.1, as console.test.mjs does. */
+function serve() {
+  return new Promise((resolve) => {
+    const s = http.createServer(async (req, res) => {
+      const url = new URL(req.url, 'http://127.0.0.1');
+      let file = path.normalize(path.join(dist, decodeURIComponent(url.pathname)));
+      if (!file.startsWith(dist)) {
+        res.writeHead(403).end();
+        return;
+      }
+      if (url.pathname.endsWith('/')) file = path.join(file, 'index.html');
+      try {
+        const body = await fs.readFile(file);
+        const type = TYPES[path.extname(file)] ?? 'application/octet-stream';
+        res.writeHead(200, { 'content-type': type, 'cache-control': 'no-store' }).end(body);
+      } catch {
+        res.writeHead(404).end('not found');
+      }
+    });
+    s.listen(0, '127.0.0.1', () => resolve(s));
+  });
+}
+
+const kib = (n) => `${(n / 1024).toFixed(1)} KiB`;
+const msText = (x) => `${x.toFixed(1)} ms`;
+
+/** gzip -9 of every wasm, JS and CSS file of dist/. */
+async function sizes() {
+  const files = (await fs.readdir(dist)).filter((f) => /\.(wasm|js|css)$/.test(f)).sort();
+  const rows = [];
+  for (const f of files) {
+    const body = await fs.readFile(path.join(dist, f));
+    const gz = zlib.gzipSync(body, { level: 9 }).length;
+    rows.push({ file: f, raw: body.length, gz });
+  }
+  return rows;
+}
+
+/**
+ * Bytes on the wire of one MIB read, from the last complete exchange in the
+ * console's traffic log: the modem's status message, the host's
+ * MIB_ReadRequest, the modem's ACK, its MIB_ReadConfirm and the host's ACK.
+ */
+async function exchange(page) {
+  const rows = await page.$$eval('#traffic-table tbody tr', (trs) =>
+    trs.slice(-40).map((tr) => ({
+      title: tr.querySelector('td.title')?.textContent ?? '',
+      way: tr.className,
+      bytes: (tr.querySelector('td.hex')?.textContent ?? '').trim().split(/\s+/).filter(Boolean)
+        .length,
+    })),
+  );
+  const confirm = rows.findLastIndex((r) => r.title === 'MIB_ReadConfirm');
+  const request = rows.findLastIndex((r, i) => i < confirm && r.title === 'MIB_ReadRequest');
+  const status = rows.findLastIndex((r, i) => i < request && r.way.includes('kind-status'));
+  const ack = rows.findIndex((r, i) => i > confirm && r.way.includes('from-host kind-ack'));
+  if ([confirm, request, status, ack].some((i) => i < 0)) {
+    throw new Error(`no complete MIB read exchange in the traffic log: ${JSON.stringify(rows)}`);
+  }
+  const parts = rows.slice(status, ack + 1).map((r) => ({
+    name: r.way.includes('kind-status') ? 'status' : r.way.includes('kind-ack') ? 'ACK' : r.title,
+    bytes: r.bytes,
+  }));
+  return parts;
+}
+
+async function main() {
+  await fs.access(path.join(dist, 'index.html')).catch(() => {
+    throw new Error(`no console build in ${dist}: run \`cargo xtask dist\` first`);
+  });
+  await fs.mkdir(artifacts, { recursive: true });
+  const server = await serve();
+  const base = `http://127.0.0.1:${server.address().port}/`;
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: [
+      '--headless',
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-quic',
+      '--no-first-run',
+      '--disable-background-networking',
+      '--disable-component-update',
+      '--disable-sync',
+    ],
+  });
+  try {
+    const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+    const errors = [];
+    page.on('pageerror', (e) => errors.push(String(e)));
+    page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+
+    await page.goto(base + '#diagnostics');
+    await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+    await page.waitForFunction(() => window.plmBench !== undefined);
+    // The simulated modem has booted once its BIO_ResetIndication is in.
+    await page.waitForFunction(() => window.plmBench.ackLatency().count > 0, null, {
+      timeout: 15_000,
+    });
+    const baud = await page.evaluate((b) => window.plmBench.setBaud(b), BAUD);
+    if (baud !== BAUD) throw new Error(`the console would not take ${BAUD} baud (it has ${baud})`);
+
+    const reads = (n, chained) =>
+      page.evaluate(([n, i, c]) => window.plmBench.mibReads(n, i, c), [n, MIB_INDEX, chained]);
+    const checked = (r, what) => {
+      if (r.failed > 0) throw new Error(`${what}: ${r.failed} of ${r.reads} failed: ${r.firstError}`);
+      return r;
+    };
+    checked(await reads(WARM_UP, false), 'warm-up');
+    const queued = checked(await reads(READS, false), 'queued reads');
+    const chained = checked(await reads(READS, true), 'chained reads');
+    const ack = await page.evaluate(() => window.plmBench.ackLatency());
+    const parts = await exchange(page);
+    await page.screenshot({ path: path.join(artifacts, 'bench-diagnostics.png') });
+    if (errors.length) throw new Error(`errors in the page: ${errors.join('; ')}`);
+
+    const bytes = parts.reduce((n, p) => n + p.bytes, 0);
+    const wireMs = (bytes * BITS_PER_BYTE * 1000) / BAUD;
+    const limit = 1000 / wireMs;
+    const rate = (r) => (r.reads * 1000) / r.elapsedMs;
+    const pct = (x) => `${((100 * x) / limit).toFixed(0)}% of the limit`;
+    const dsizes = await sizes();
+    const total = dsizes.reduce((a, r) => ({ raw: a.raw + r.raw, gz: a.gz + r.gz }), {
+      raw: 0,
+      gz: 0,
+    });
+    const spread = (s) =>
+      `p50 ${msText(s.p50).padStart(7)}   p99 ${msText(s.p99).padStart(7)}   max ${msText(s.max).padStart(7)}`;
+
+    const out = [
+      '',
+      `PLM Console, Chromium ${browser.version()}, simulated ST7580 at ${BAUD} baud`,
+      '',
+      `ACK latency, last byte of a modem frame to the host's ACK (${ack.count} frames; T_ACK ${ack.tAck} ms):`,
+      `  page's clock   ${spread(ack.page)}   (includes the page's timer period and stalls)`,
+      `  virtual link   ${spread(ack.link)}   (what the simulated modem saw: its time waits for the page)`,
+      '',
+      `MIB reads (MIB_ReadRequest ${MIB_INDEX.toString(16).padStart(2, '0').toUpperCase()}h, ${queued.dataLen}-byte value), ${READS} each:`,
+      `  queued   ${READS} in ${msText(queued.elapsedMs)} = ${rate(queued).toFixed(0)} /s (${pct(rate(queued))}; the session sends the next on each answer)`,
+      `  chained  ${READS} in ${msText(chained.elapsedMs)} = ${rate(chained).toFixed(0)} /s (${pct(rate(chained))}; the next sent from the reply, as a view does)`,
+      `  wire-time limit: ${parts.map((p) => `${p.name} ${p.bytes}`).join(' + ')} = ${bytes} bytes`,
+      `    x ${BITS_PER_BYTE} bits / ${BAUD} baud = ${wireMs.toFixed(2)} ms -> ${limit.toFixed(0)} round trips /s`,
+      '',
+      'Size, gzip -9:',
+      ...dsizes.map((r) => `  ${r.file.padEnd(40)} ${kib(r.raw).padStart(10)} -> ${kib(r.gz).padStart(9)}`),
+      `  ${'total'.padEnd(40)} ${kib(total.raw).padStart(10)} -> ${kib(total.gz).padStart(9)}`,
+      '',
+    ];
+    console.log(out.join('\n'));
+  } finally {
+    await browser.close();
+    await new Promise((r) => server.close(r));
+  }
+}
+
+main().catch((e) => {
+  console.error(`bench: ${e.message ?? e}`);
+  process.exit(1);
+});

@@ -1,0 +1,528 @@
+// Browser end-to-end journeys of PLM Console through its WebSerial
+// transport: the real transport code (crates/plm-console/src/transport/
+// webserial.rs) runs on a scripted navigator.serial (serial-shim.mjs) whose
+// port is backed, through page bindings and an RFC 2217 client
+// (rfc2217.mjs), by a real `plm sim --chip st7580` process, one per test.
+// So RTS really toggles T_REQ in the simulated modem, and every byte really
+// crosses a UART model at the chosen baud rate.
+//
+// Like console.test.mjs, it serves the release build in dist/ (built by
+// `cargo xtask test` / `cargo xtask dist`), drives Debian's Chromium with
+// playwright-core, fails on any page error, and saves screenshots into
+// artifacts/.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import http from 'node:http';
+import fs from 'node:fs/promises';
+import { existsSync } from 'node:fs';
+import path from 'node:path';
+import readline from 'node:readline';
+import { spawn, spawnSync } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+import { Rfc2217Client } from './rfc2217.mjs';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const root = path.resolve(here, '../..');
+const dist = path.join(root, 'dist');
+const artifacts = path.join(here, 'artifacts');
+const shim = path.join(here, 'serial-shim.mjs');
+const targetDir = process.env.CARGO_TARGET_DIR
+  ? path.resolve(root, process.env.CARGO_TARGET_DIR)
+  : path.join(root, 'target');
+const plmBin = process.env.PLM_BIN ?? path.join(targetDir, 'debug', process.platform === 'win32' ? 'plm.exe' : 'plm');
+
+const TYPES = {
+  '.html': 'text/html; charset=utf-8',
+  '.js': 'text/javascript',
+  '.wasm': 'application/wasm',
+  '.css': 'text/css',
+  '.json': 'application/json',
+  '.svg': 'image/svg+xml',
+  '.png': 'image/png',
+  '.webmanifest': 'application/manifest+json',
+};
+
+let server;
+let base;
+let browser;
+
+/** Serves dist/ on 127.0.0.1 (a secure context, as WebSerial needs). */
+function serve() {
+  return new Promise((resolve) => {
+    const s = http.createServer(async (req, res) => {
+      const url = new URL(req.url, 'http://127.0.0.1');
+      let file = path.normalize(path.join(dist, decodeURIComponent(url.pathname)));
+      if (!file.startsWith(dist)) {
+        res.writeHead(403).end();
+        return;
+      }
+      if (url.pathname.endsWith('/')) file = path.join(file, 'index.html');
+      try {
+        const body = await fs.readFile(file);
+        const type = TYPES[path.extname(file)] ?? 'application/octet-stream';
+        res.writeHead(200, { 'content-type': type, 'cache-control': 'no-store' }).end(body);
+      } catch {
+        res.writeHead(404).end('not found');
+      }
+    });
+    s.listen(0, '127.0.0.1', () => resolve(s));
+  });
+}
+
+/** The `plm` binary, built if it is not there yet. */
+function ensurePlm() {
+  if (existsSync(plmBin)) return;
+  console.log(`webserial: ${plmBin} is missing; building it (cargo build -p plm-cli)`);
+  const r = spawnSync('cargo', ['build', '-p', 'plm-cli'], { cwd: root, stdio: 'inherit' });
+  if (r.error || r.status !== 0 || !existsSync(plmBin)) {
+    throw new Error(
+      `the simulated modem (${plmBin}) is missing and \`cargo build -p plm-cli\` could not build it` +
+        (r.error ? `: ${r.error.message}` : ` (exit ${r.status})`) +
+        '. Build it by hand, or point PLM_BIN at a plm binary.',
+    );
+  }
+}
+
+/**
+ * Starts `plm sim --chip st7580 --listen 127.0.0.1:0 --nodes <n>` and waits
+ * for the address it prints. Resolves to {host, port, stop()}.
+ */
+async function startSim(nodes = 2) {
+  const child = spawn(plmBin, ['sim', '--chip', 'st7580', '--listen', '127.0.0.1:0', '--nodes', String(nodes)], {
+    stdio: ['ignore', 'pipe', 'pipe'],
+  });
+  const output = [];
+  child.stderr.on('data', (d) => output.push(String(d)));
+  const lines = readline.createInterface({ input: child.stdout });
+  const address = await new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`plm sim printed no address in 10 s: ${output.join('')}`)), 10_000);
+    child.once('exit', (code) => {
+      clearTimeout(timer);
+      reject(new Error(`plm sim exited (${code}) before listening: ${output.join('')}`));
+    });
+    lines.on('line', (line) => {
+      output.push(line + '\n');
+      const m = /as RFC 2217 on (\S+)/.exec(line);
+      if (m) {
+        clearTimeout(timer);
+        resolve(m[1]);
+      }
+    });
+  });
+  const colon = address.lastIndexOf(':');
+  return {
+    host: address.slice(0, colon),
+    port: Number(address.slice(colon + 1)),
+    output,
+    async stop() {
+      if (child.exitCode !== null) return;
+      const exited = new Promise((r) => child.once('exit', r));
+      child.kill('SIGTERM');
+      const timer = setTimeout(() => child.kill('SIGKILL'), 3_000);
+      await exited;
+      clearTimeout(timer);
+    },
+  };
+}
+
+/**
+ * The Node side of the scripted port: each open() of the page's port is an
+ * RFC 2217 connection to the simulator. `wire` collects every client
+ * (with its log of writes and RTS changes).
+ */
+async function bridge(context, sim) {
+  const wire = { clients: [], current: null, opens: [] };
+  let page = null;
+  wire.attach = (p) => {
+    page = p;
+    // A new document (a reload) has no open port: the browser closed the
+    // old document's. (Not 'framenavigated': a change of tab changes the
+    // URL's fragment, which is a navigation too.)
+    page.on('domcontentloaded', () => {
+      wire.current?.close();
+      wire.current = null;
+    });
+  };
+  await context.exposeBinding('__plmSerialOpen', async (_source, id, settings) => {
+    wire.opens.push(settings);
+    const client = await Rfc2217Client.connect({ host: sim.host, port: sim.port, baud: settings.baudRate });
+    client.on('data', (bytes) => {
+      page
+        ?.evaluate(([i, b]) => window.__plmSerialShim.receive(i, b), [id, [...bytes]])
+        .catch(() => {});
+    });
+    wire.clients.push(client);
+    wire.current = client;
+    return true;
+  });
+  await context.exposeBinding('__plmSerialWrite', (_source, _id, bytes) => {
+    wire.current?.write(bytes);
+  });
+  await context.exposeBinding('__plmSerialSignals', (_source, _id, signals) => {
+    if ('rts' in signals) wire.current?.setRts(signals.rts);
+  });
+  await context.exposeBinding('__plmSerialClose', (_source, _id) => {
+    wire.current?.close();
+    wire.current = null;
+  });
+  return wire;
+}
+
+before(async () => {
+  await fs.access(path.join(dist, 'index.html')).catch(() => {
+    throw new Error(`no console build in ${dist}: run \`cargo xtask dist\` first`);
+  });
+  ensurePlm();
+  await fs.mkdir(artifacts, { recursive: true });
+  server = await serve();
+  base = `http://127.0.0.1:${server.address().port}/`;
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: [
+      '--headless',
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-quic',
+      '--no-first-run',
+      '--disable-background-networking',
+      '--disable-component-update',
+      '--disable-sync',
+    ],
+  });
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((r) => (server ? server.close(r) : r()));
+});
+
+/**
+ * A fresh page with the scripted port, backed by a fresh simulator with
+ * `nodes` modems (node 0 on the port, the others echo). Fails the test on
+ * page errors.
+ */
+async function open(t, { nodes = 2 } = {}) {
+  const sim = await startSim(nodes);
+  const context = await browser.newContext({
+    acceptDownloads: true,
+    viewport: { width: 1400, height: 900 },
+  });
+  const wire = await bridge(context, sim);
+  await context.addInitScript({ path: shim });
+  const page = await context.newPage();
+  wire.attach(page);
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+  });
+  t.after(async () => {
+    await context.close();
+    for (const c of wire.clients) c.close();
+    await sim.stop();
+    assert.deepEqual(errors, [], 'no errors in the page');
+  });
+  await page.goto(base);
+  // The simulated modem in the page is the default.
+  await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+  return { page, wire, sim, context };
+}
+
+/** Opens the WebSerial panel. */
+async function panel(page) {
+  if ((await page.getAttribute('#serial-toggle', 'aria-expanded')) !== 'true') {
+    await page.click('#serial-toggle');
+  }
+  await page.locator('#serial-panel').waitFor({ state: 'visible' });
+}
+
+/**
+ * Chooses WebSerial: grants the scripted port (unless it is remembered),
+ * picks `baud`, connects, and waits for the modem's BIO_ResetIndication
+ * (the simulated modems power on when the first client connects).
+ */
+async function connectSerial(page, { baud = 57600, grant = true, reset = true, screenshot } = {}) {
+  await panel(page);
+  if (grant) await page.click('#serial-choose');
+  await page.locator('#serial-port option', { hasText: 'USB 0403:6015' }).waitFor({ state: 'attached' });
+  await page.selectOption('#serial-baud', String(baud));
+  if (screenshot) await shot(page, screenshot);
+  await page.click('#serial-connect');
+  await page.locator('#conn-port', { hasText: 'WebSerial' }).waitFor();
+  await page.locator('#conn-state.ok').waitFor();
+  await page.locator('#serial-panel').waitFor({ state: 'hidden' });
+  if (reset) {
+    await page.locator('#traffic-table tbody tr', { hasText: 'BIO_ResetIndication' }).first().waitFor();
+  }
+}
+
+async function tab(page, slug) {
+  await page.click(`#tab-${slug}`);
+  await page.locator(`#view-${slug}`).waitFor({ state: 'visible' });
+}
+
+async function shot(page, name) {
+  await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: false });
+}
+
+/** Titles of the traffic rows shown (Element column). */
+async function titles(page) {
+  return page.locator('#traffic-table tbody tr td.title').allTextContents();
+}
+
+/** Bytes the console wrote to the port, and RTS changes, in order. */
+function wireLog(wire) {
+  return wire.clients.flatMap((c) => c.log);
+}
+
+/** Pings and expects the PingConfirm (failing with what came instead). */
+async function ping(page) {
+  await tab(page, 'diagnostics');
+  await page.click('#ping-send');
+  const result = page.locator('#ping-result');
+  await page
+    .locator('#ping-result.problem, #ping-result:has-text("PingConfirm")')
+    .waitFor({ timeout: 10_000 });
+  assert.match(await result.textContent(), /^PingConfirm/);
+}
+
+test('WebSerial: grant the scripted port, connect at 57600, RTS drives T_REQ, ping', async (t) => {
+  const { page, wire } = await open(t);
+  await connectSerial(page, { baud: 57600, screenshot: 'webserial-panel' });
+  assert.match(await page.textContent('#conn-port'), /USB 0403:6015 \(WebSerial\)/);
+  assert.equal(await page.inputValue('#baud'), '57600');
+  // Opened 8N1 at 57600, no flow control; T_REQ released (RTS off) at once.
+  assert.deepEqual(wire.opens, [
+    { baudRate: 57600, dataBits: 8, stopBits: 1, parity: 'none', flowControl: 'none' },
+  ]);
+  const early = wireLog(wire);
+  assert.deepEqual(early[0], { at: early[0].at, rts: false }, 'T_REQ released first');
+  assert.equal(wire.current.baud, 57600, 'the simulator runs at 57600 baud (SET-BAUDRATE)');
+  await shot(page, 'webserial-connected');
+
+  await tab(page, 'diagnostics');
+  await page.fill('#ping-payload', '01 02 03 04 05 ff');
+  await page.click('#ping-send');
+  const result = page.locator('#ping-result');
+  await result.filter({ hasText: 'PingConfirm' }).waitFor();
+  assert.match(
+    await result.textContent(),
+    /^PingConfirm in \d+\.\d ms \(payload echoed intact\): 01 02 03 04 05 ff$/,
+  );
+
+  // The request went out as the ST7580 wants it (UM0932 3.2.8): RTS on
+  // (T_REQ low), then the STX, RTS off (T_REQ released), the rest; the
+  // 0xFF of the payload crossed the Telnet stream doubled and came back.
+  const log = wireLog(wire);
+  const on = log.findIndex(
+    (e, i) =>
+      e.rts === true &&
+      String(log[i + 1]?.write) === '2' &&
+      log[i + 2]?.rts === false &&
+      log[i + 3]?.write?.[1] === 0x2c,
+  );
+  assert.ok(on >= 0, `RTS on, STX, RTS off, PingRequest in ${JSON.stringify(log.map(({ at, ...e }) => e))}`);
+  assert.deepEqual(log[on + 3].write.slice(0, 8), [0x06, 0x2c, 0x01, 0x02, 0x03, 0x04, 0x05, 0xff], 'length, PingRequest, payload');
+
+  await tab(page, 'traffic');
+  const seen = await titles(page);
+  for (const want of ['BIO_ResetIndication', 'PingRequest', 'PingConfirm']) {
+    assert.ok(seen.includes(want), `${want} in ${seen.join(', ')}`);
+  }
+  await shot(page, 'webserial-traffic');
+});
+
+test('WebSerial: read, change, write and read back the PHY configuration', async (t) => {
+  const { page } = await open(t);
+  await connectSerial(page);
+  await tab(page, 'modem');
+  const card = page.locator('#mib-01');
+  const status = card.locator('[data-role=status]');
+  await card.locator('[data-action=read]').click();
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
+  const freq = card.locator('input[name=high_frequency]');
+  assert.equal(await freq.inputValue(), '86000');
+
+  await freq.fill('110000');
+  await card.locator('input[name=tx_gain]').fill('20');
+  await card.locator('[data-action=write]').click();
+  await status.filter({ hasText: 'written and read back: the modem has it' }).waitFor();
+
+  await card.locator('[data-action=read]').click();
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
+  assert.equal(await freq.inputValue(), '110000');
+  assert.equal(await card.locator('input[name=tx_gain]').inputValue(), '20');
+  assert.match(
+    await card.locator('[data-role=diff]').textContent(),
+    /2 field\(s\) differ from the factory default: High frequency, TX gain/,
+  );
+  await shot(page, 'webserial-modem');
+
+  await tab(page, 'traffic');
+  await page.selectOption('#filter-command', 'MIB_WriteRequest');
+  const rows = page.locator('#traffic-table tbody tr');
+  assert.equal(await rows.count(), 1);
+  assert.match(await rows.first().textContent(), /high_frequency=110000/);
+});
+
+test('WebSerial: a DL frame to the echoing peer comes back as a DL_DataIndication', async (t) => {
+  const { page } = await open(t, { nodes: 2 });
+  await connectSerial(page);
+  await tab(page, 'data');
+  await page.selectOption('#data-layer', 'dl');
+  await page.selectOption('#data-payload-kind', 'text');
+  await page.fill('#data-payload', 'lamp 7 on');
+  await page.click('#data-send');
+  await page.locator('#data-result', { hasText: 'DL_DataConfirm' }).waitFor({ timeout: 15_000 });
+  // "lamp 7 on" in hex.
+  const row = page.locator('#indications-table tbody tr', { hasText: 'DL_DataIndication' }).first();
+  await row.waitFor({ timeout: 15_000 });
+  assert.match(await row.textContent(), /6c 61 6d 70 20 37 20 6f 6e/);
+  await shot(page, 'webserial-data');
+});
+
+test('WebSerial: an out-of-range frequency is refused in the form and nothing is sent', async (t) => {
+  const { page, wire } = await open(t);
+  await connectSerial(page);
+  await tab(page, 'modem');
+  // Let the link settle (the reset indication's ACK), then count.
+  await page.waitForTimeout(200);
+  const sent = wireLog(wire).length;
+  const card = page.locator('#mib-01');
+  await card.locator('input[name=high_frequency]').fill('200000');
+  await card.locator('[data-action=write]').click();
+  const reason = card.locator('tr[data-field=high_frequency] [data-role=problem]');
+  await reason.filter({ hasText: '200000 is out of range 3000..=148500 Hz' }).waitFor();
+  assert.ok(await reason.isVisible());
+  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
+  // Give a wrongly sent request time to reach the port, then look.
+  await page.waitForTimeout(300);
+  assert.deepEqual(wireLog(wire).slice(sent), [], 'not a byte, not an RTS change on the port');
+  await tab(page, 'traffic');
+  assert.ok(!(await titles(page)).includes('MIB_WriteRequest'));
+});
+
+test('WebSerial: unplugged mid-command, the console says so, nothing is stuck, and it reconnects', async (t) => {
+  const { page, wire } = await open(t);
+  await connectSerial(page);
+  await tab(page, 'diagnostics');
+  // The request is handed to the link (T_REQ about to be asserted) and the
+  // adapter is pulled out in the same moment.
+  await page.evaluate(() => {
+    document.querySelector('#ping-send').click();
+    window.__plmSerialShim.unplug();
+  });
+  const result = page.locator('#ping-result.problem');
+  await result.waitFor({ timeout: 5_000 });
+  assert.doesNotMatch(await result.textContent(), /PingConfirm/);
+  await page.locator('#conn-state:not(.ok)').waitFor();
+  assert.match(await page.getAttribute('#conn-state', 'title'), /the serial port was unplugged/);
+  await page.locator('.toast', { hasText: 'the serial port was unplugged' }).waitFor();
+  await shot(page, 'webserial-unplugged');
+  // Nothing stuck: a new request fails at once, in words.
+  await page.click('#ping-send');
+  await page.locator('#ping-result.problem', { hasText: /not connected|unplugged/ }).waitFor();
+  // The port was released: the streams unlocked and the port closed.
+  assert.deepEqual(await page.evaluate(() => window.__plmSerialShim.state()), { open: false, plugged: false, rts: false });
+  await panel(page);
+  assert.equal(await page.locator('#serial-port option', { hasText: 'USB 0403:6015' }).count(), 0, 'an unplugged port is not offered');
+
+  // Plugged back in: offered again (remembered, no new grant), and it works.
+  await page.evaluate(() => window.__plmSerialShim.replug());
+  await connectSerial(page, { grant: false, reset: false });
+  assert.equal(wire.clients.length, 2);
+  await ping(page);
+});
+
+test('WebSerial: the granted port and settings are remembered across a reload; back to the simulator closes it', async (t) => {
+  const { page, wire } = await open(t);
+  await connectSerial(page, { baud: 38400 });
+  assert.equal(wire.current.baud, 38400);
+  await ping(page);
+  await page.reload();
+  await page.locator('#conn-state.ok').waitFor();
+  assert.match(await page.textContent('#conn-port'), /simulated/, 'a reload starts on the simulated modem');
+  await panel(page);
+  // Remembered: the port (no new grant) and the baud rate.
+  await page.locator('#serial-port option', { hasText: 'USB 0403:6015' }).waitFor({ state: 'attached' });
+  assert.equal(await page.inputValue('#serial-baud'), '38400');
+  assert.equal(await page.inputValue('#serial-polarity'), 'low');
+  await page.click('#serial-connect');
+  await page.locator('#conn-port', { hasText: 'WebSerial' }).waitFor();
+  await ping(page);
+  await panel(page);
+  await page.click('#serial-use-sim');
+  await page.locator('#conn-port', { hasText: 'simulated' }).waitFor();
+  await page.waitForFunction(() => !window.__plmSerialShim.state().open);
+  assert.equal(wire.current, null, 'the RFC 2217 connection was closed');
+  await ping(page);
+});
+
+test('WebSerial: a new baud rate in the connection bar reopens the port at that rate', async (t) => {
+  const { page, wire } = await open(t);
+  await connectSerial(page, { baud: 57600 });
+  await ping(page);
+  await page.selectOption('#baud', '19200');
+  // Web Serial fixes the rate at open(): the port is closed and opened
+  // again, which here is a new RFC 2217 connection at 19200 baud.
+  await page.waitForFunction(() => window.__plmSerialShim.log.filter((e) => e.open).length === 2);
+  assert.deepEqual(
+    wire.opens.map((o) => o.baudRate),
+    [57600, 19200],
+  );
+  assert.equal(wire.current.baud, 19200, 'the simulated modem runs at 19200 baud');
+  assert.match(await page.textContent('#conn-port'), /WebSerial/);
+  await ping(page);
+});
+
+test('WebSerial: the traffic log exports to JSON Lines and imports again', async (t) => {
+  const { page } = await open(t);
+  await connectSerial(page);
+  await ping(page);
+  await tab(page, 'traffic');
+  await page.click('#traffic-pause');
+  const before = await titles(page);
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#traffic-export')]);
+  assert.equal(download.suggestedFilename(), 'plm-traffic.jsonl');
+  const file = path.join(artifacts, 'webserial-traffic.jsonl');
+  await download.saveAs(file);
+  const lines = (await fs.readFile(file, 'utf8')).trim().split('\n');
+  assert.equal(lines.length, before.length);
+  const entries = lines.map((l) => JSON.parse(l));
+  for (const e of entries) {
+    assert.equal(typeof e.time_us, 'number');
+    assert.match(e.hex, /^([0-9a-f]{2})+$/);
+  }
+  assert.ok(entries.some((e) => e.command === 'PingConfirm' && e.from === 'modem'));
+
+  await page.click('#traffic-clear');
+  assert.equal(await page.locator('#traffic-table tbody tr').count(), 0);
+  await page.setInputFiles('#traffic-import', file);
+  await page.locator('#traffic-message', { hasText: `Imported ${lines.length} elements` }).waitFor();
+  assert.deepEqual(await titles(page), before);
+});
+
+test('a browser without WebSerial is told so plainly, and the simulated modem still works', async (t) => {
+  const context = await browser.newContext({ viewport: { width: 1400, height: 900 } });
+  await context.addInitScript(() => {
+    delete Navigator.prototype.serial;
+  });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  t.after(async () => {
+    await context.close();
+    assert.deepEqual(errors, [], 'no errors in the page');
+  });
+  await page.goto(base);
+  await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+  assert.equal(await page.textContent('#serial-toggle'), 'WebSerial: not in this browser');
+  await panel(page);
+  assert.match(await page.textContent('#serial-unavailable'), /This browser has no WebSerial .* The simulated modem works here\./);
+  assert.equal(await page.locator('#serial-connect').count(), 0);
+  await shot(page, 'webserial-unavailable');
+  await page.click('#serial-close');
+  await ping(page);
+});
