@@ -16,16 +16,11 @@
 // PLM_DIST (another build directory), PLM_BENCH_READS (default 300) and
 // CHROMIUM override the defaults.
 
-import http from 'node:http';
 import fs from 'node:fs/promises';
 import path from 'node:path';
 import zlib from 'node:zlib';
-import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { artifacts, dist, launchChromium, serveDist } from './harness.mjs';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const dist = path.resolve(process.env.PLM_DIST ?? path.join(here, '../../dist'));
-const artifacts = path.join(here, 'artifacts');
 const READS = Number(process.env.PLM_BENCH_READS ?? 300);
 const WARM_UP = 20;
 const BAUD = 57_600;
@@ -34,39 +29,6 @@ const BITS_PER_BYTE = 10;
 /** MIB object read: 0Ah, firmware version (UM0932 4.2.10). */
 const MIB_INDEX = 0x0a;
 
-const TYPES = {
-  '.html': 'text/html; charset=utf-8',
-  '.js': 'text/javascript',
-  '.wasm': 'application/wasm',
-  '.css': 'text/css',
-  '.json': 'application/json',
-  '.svg': 'image/svg+xml',
-  '.png': 'image/png',
-  '.webmanifest': 'application/manifest+json',
-};
-
-/** Serves `dist` on 127.0.0.1, as console.test.mjs does. */
-function serve() {
-  return new Promise((resolve) => {
-    const s = http.createServer(async (req, res) => {
-      const url = new URL(req.url, 'http://127.0.0.1');
-      let file = path.normalize(path.join(dist, decodeURIComponent(url.pathname)));
-      if (!file.startsWith(dist)) {
-        res.writeHead(403).end();
-        return;
-      }
-      if (url.pathname.endsWith('/')) file = path.join(file, 'index.html');
-      try {
-        const body = await fs.readFile(file);
-        const type = TYPES[path.extname(file)] ?? 'application/octet-stream';
-        res.writeHead(200, { 'content-type': type, 'cache-control': 'no-store' }).end(body);
-      } catch {
-        res.writeHead(404).end('not found');
-      }
-    });
-    s.listen(0, '127.0.0.1', () => resolve(s));
-  });
-}
 
 const kib = (n) => `${(n / 1024).toFixed(1)} KiB`;
 const msText = (x) => `${x.toFixed(1)} ms`;
@@ -112,25 +74,8 @@ async function exchange(page) {
 }
 
 async function main() {
-  await fs.access(path.join(dist, 'index.html')).catch(() => {
-    throw new Error(`no console build in ${dist}: run \`cargo xtask dist\` first`);
-  });
-  await fs.mkdir(artifacts, { recursive: true });
-  const server = await serve();
-  const base = `http://127.0.0.1:${server.address().port}/`;
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-    args: [
-      '--headless',
-      '--no-sandbox',
-      '--disable-gpu',
-      '--disable-quic',
-      '--no-first-run',
-      '--disable-background-networking',
-      '--disable-component-update',
-      '--disable-sync',
-    ],
-  });
+  const { server, base } = await serveDist();
+  const browser = await launchChromium();
   try {
     const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
     const errors = [];

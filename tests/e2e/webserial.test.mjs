@@ -13,63 +13,27 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import http from 'node:http';
 import fs from 'node:fs/promises';
 import { existsSync } from 'node:fs';
 import path from 'node:path';
 import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { artifacts, launchChromium, serveDist } from './harness.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const root = path.resolve(here, '../..');
-const dist = path.join(root, 'dist');
-const artifacts = path.join(here, 'artifacts');
 const shim = path.join(here, 'serial-shim.mjs');
 const targetDir = process.env.CARGO_TARGET_DIR
   ? path.resolve(root, process.env.CARGO_TARGET_DIR)
   : path.join(root, 'target');
 const plmBin = process.env.PLM_BIN ?? path.join(targetDir, 'debug', process.platform === 'win32' ? 'plm.exe' : 'plm');
 
-const TYPES = {
-  '.html': 'text/html; charset=utf-8',
-  '.js': 'text/javascript',
-  '.wasm': 'application/wasm',
-  '.css': 'text/css',
-  '.json': 'application/json',
-  '.svg': 'image/svg+xml',
-  '.png': 'image/png',
-  '.webmanifest': 'application/manifest+json',
-};
-
 let server;
 let base;
 let browser;
 
-/** Serves dist/ on 127.0.0.1 (a secure context, as WebSerial needs). */
-function serve() {
-  return new Promise((resolve) => {
-    const s = http.createServer(async (req, res) => {
-      const url = new URL(req.url, 'http://127.0.0.1');
-      let file = path.normalize(path.join(dist, decodeURIComponent(url.pathname)));
-      if (!file.startsWith(dist)) {
-        res.writeHead(403).end();
-        return;
-      }
-      if (url.pathname.endsWith('/')) file = path.join(file, 'index.html');
-      try {
-        const body = await fs.readFile(file);
-        const type = TYPES[path.extname(file)] ?? 'application/octet-stream';
-        res.writeHead(200, { 'content-type': type, 'cache-control': 'no-store' }).end(body);
-      } catch {
-        res.writeHead(404).end('not found');
-      }
-    });
-    s.listen(0, '127.0.0.1', () => resolve(s));
-  });
-}
 
 /** The `plm` binary, built if it is not there yet. */
 function ensurePlm() {
@@ -171,26 +135,9 @@ async function bridge(context, sim) {
 }
 
 before(async () => {
-  await fs.access(path.join(dist, 'index.html')).catch(() => {
-    throw new Error(`no console build in ${dist}: run \`cargo xtask dist\` first`);
-  });
   ensurePlm();
-  await fs.mkdir(artifacts, { recursive: true });
-  server = await serve();
-  base = `http://127.0.0.1:${server.address().port}/`;
-  browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-    args: [
-      '--headless',
-      '--no-sandbox',
-      '--disable-gpu',
-      '--disable-quic',
-      '--no-first-run',
-      '--disable-background-networking',
-      '--disable-component-update',
-      '--disable-sync',
-    ],
-  });
+  ({ server, base } = await serveDist());
+  browser = await launchChromium();
 });
 
 after(async () => {

@@ -1,0 +1,70 @@
+// What every browser script here shares: the release build in dist/ served
+// on 127.0.0.1 (a secure context, as WebSerial needs) and Debian's Chromium
+// driven by playwright-core with the flags this machine's closed network
+// needs (see /work/.library/env: no background networking).
+
+import http from 'node:http';
+import fs from 'node:fs/promises';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+export const dist = path.resolve(process.env.PLM_DIST ?? path.join(here, '../../dist'));
+export const artifacts = path.join(here, 'artifacts');
+
+const TYPES = {
+  '.html': 'text/html; charset=utf-8',
+  '.js': 'text/javascript',
+  '.wasm': 'application/wasm',
+  '.css': 'text/css',
+  '.json': 'application/json',
+  '.svg': 'image/svg+xml',
+  '.png': 'image/png',
+  '.webmanifest': 'application/manifest+json',
+};
+
+/** Serves dist/ on a free port; resolves to { server, base }. */
+export async function serveDist() {
+  await fs.access(path.join(dist, 'index.html')).catch(() => {
+    throw new Error(`no console build in ${dist}: run \`cargo xtask dist\` first`);
+  });
+  await fs.mkdir(artifacts, { recursive: true });
+  const server = await new Promise((resolve) => {
+    const s = http.createServer(async (req, res) => {
+      const url = new URL(req.url, 'http://127.0.0.1');
+      let file = path.normalize(path.join(dist, decodeURIComponent(url.pathname)));
+      if (!file.startsWith(dist)) {
+        res.writeHead(403).end();
+        return;
+      }
+      if (url.pathname.endsWith('/')) file = path.join(file, 'index.html');
+      try {
+        const body = await fs.readFile(file);
+        const type = TYPES[path.extname(file)] ?? 'application/octet-stream';
+        res.writeHead(200, { 'content-type': type, 'cache-control': 'no-store' }).end(body);
+      } catch {
+        res.writeHead(404).end('not found');
+      }
+    });
+    s.listen(0, '127.0.0.1', () => resolve(s));
+  });
+  return { server, base: `http://127.0.0.1:${server.address().port}/` };
+}
+
+/** Headless Debian Chromium (CHROMIUM overrides the path). */
+export function launchChromium() {
+  return chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    args: [
+      '--headless',
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-quic',
+      '--no-first-run',
+      '--disable-background-networking',
+      '--disable-component-update',
+      '--disable-sync',
+    ],
+  });
+}
