@@ -9,6 +9,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import path from 'node:path';
 import { artifacts, launchChromium, serveDist } from './harness.mjs';
+import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 
 
 let server;
@@ -45,20 +46,6 @@ async function open(t, hash = '') {
   await page.goto(base + hash);
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   return page;
-}
-
-async function tab(page, slug) {
-  await page.click(`#tab-${slug}`);
-  await page.locator(`#view-${slug}`).waitFor({ state: 'visible' });
-}
-
-async function shot(page, name) {
-  await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: false });
-}
-
-/** Titles of the traffic rows shown (Element column). */
-async function titles(page) {
-  return page.locator('#traffic-table tbody tr td.title').allTextContents();
 }
 
 test('the page opens connected to the simulated modem, which reports its reset', async (t) => {
@@ -99,35 +86,7 @@ test('ping shows the PingConfirm and its round-trip time', async (t) => {
 
 test('read, change, write and read back the PHY configuration', async (t) => {
   const page = await open(t, '#modem');
-  const card = page.locator('#mib-01');
-  const status = card.locator('[data-role=status]');
-  await card.locator('[data-action=read]').click();
-  await status.filter({ hasText: 'read from the modem' }).waitFor();
-  const freq = card.locator('input[name=high_frequency]');
-  assert.equal(await freq.inputValue(), '86000');
-  assert.equal(await card.locator('[data-role=diff]').textContent(), 'equal to the factory default');
-
-  await freq.fill('110000');
-  await card.locator('input[name=tx_gain]').fill('20');
-  await card.locator('[data-action=write]').click();
-  await status.filter({ hasText: 'written and read back: the modem has it' }).waitFor();
-
-  // Read it back once more, by hand.
-  await card.locator('[data-action=read]').click();
-  await status.filter({ hasText: 'read from the modem' }).waitFor();
-  assert.equal(await freq.inputValue(), '110000');
-  assert.equal(await card.locator('input[name=tx_gain]').inputValue(), '20');
-  assert.match(
-    await card.locator('[data-role=diff]').textContent(),
-    /2 field\(s\) differ from the factory default: High frequency, TX gain/,
-  );
-  await shot(page, 'modem');
-
-  await tab(page, 'traffic');
-  await page.selectOption('#filter-command', 'MIB_WriteRequest');
-  const rows = page.locator('#traffic-table tbody tr');
-  assert.equal(await rows.count(), 1);
-  assert.match(await rows.first().textContent(), /high_frequency=110000/);
+  await phyRoundTrip(page, 'modem');
 });
 
 test('a profile saved to a file and loaded back restores the configuration', async (t) => {
@@ -167,54 +126,17 @@ test('a profile saved to a file and loaded back restores the configuration', asy
 
 test('an out-of-range frequency is refused in the form and nothing is sent', async (t) => {
   const page = await open(t, '#modem');
-  const card = page.locator('#mib-01');
-  await card.locator('input[name=high_frequency]').fill('200000');
-  await card.locator('[data-action=write]').click();
-  const reason = card.locator('tr[data-field=high_frequency] [data-role=problem]');
-  await reason.filter({ hasText: '200000 is out of range 3000..=148500 Hz' }).waitFor();
-  assert.ok(await reason.isVisible());
-  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
-  await shot(page, 'modem-refused');
-  // Give a wrongly sent request time to show up, then look for it.
-  await page.waitForTimeout(300);
-  await tab(page, 'traffic');
-  const all = await titles(page);
-  assert.ok(all.length > 0, 'the log has the reset indication');
-  assert.ok(!all.includes('MIB_WriteRequest'), all.join(', '));
+  await refusedFrequency(page, 'modem-refused');
 });
 
 test('the traffic log exports to JSON Lines and imports again', async (t) => {
   const page = await open(t, '#diagnostics');
   await page.click('#ping-send');
   await page.locator('#ping-result', { hasText: 'PingConfirm' }).waitFor();
-  await tab(page, 'traffic');
-  await page.click('#traffic-pause');
-  const before = await titles(page);
-  const [download] = await Promise.all([
-    page.waitForEvent('download'),
-    page.click('#traffic-export'),
-  ]);
-  assert.equal(download.suggestedFilename(), 'plm-traffic.jsonl');
-  const file = path.join(artifacts, 'plm-traffic.jsonl');
-  await download.saveAs(file);
-  const lines = (await fs.readFile(file, 'utf8')).trim().split('\n');
-  assert.equal(lines.length, before.length);
-  for (const line of lines) {
-    const e = JSON.parse(line);
-    assert.equal(typeof e.time_us, 'number');
-    assert.ok(['frame', 'ack', 'nak', 'status', 'garbage'].includes(e.kind), line);
-    assert.match(e.hex, /^([0-9a-f]{2})+$/);
-  }
-  const ping = lines.map((l) => JSON.parse(l)).find((e) => e.command === 'PingRequest');
+  const entries = await exportImport(page, 'plm-traffic.jsonl', 'traffic-imported');
+  const ping = entries.find((e) => e.command === 'PingRequest');
   assert.equal(ping.from, 'host');
   assert.equal(ping.fields.data, '504c4d21');
-
-  await page.click('#traffic-clear');
-  assert.equal(await page.locator('#traffic-table tbody tr').count(), 0);
-  await page.setInputFiles('#traffic-import', file);
-  await page.locator('#traffic-message', { hasText: `Imported ${lines.length} elements` }).waitFor();
-  assert.deepEqual(await titles(page), before);
-  await shot(page, 'traffic-imported');
 });
 
 test('the simulator unplugs the cable, the console says so, and recovers', async (t) => {

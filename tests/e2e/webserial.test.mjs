@@ -19,7 +19,8 @@ import path from 'node:path';
 import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { artifacts, launchChromium, serveDist } from './harness.mjs';
+import { launchChromium, serveDist } from './harness.mjs';
+import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -205,20 +206,6 @@ async function connectSerial(page, { baud = 57600, grant = true, reset = true, s
   }
 }
 
-async function tab(page, slug) {
-  await page.click(`#tab-${slug}`);
-  await page.locator(`#view-${slug}`).waitFor({ state: 'visible' });
-}
-
-async function shot(page, name) {
-  await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: false });
-}
-
-/** Titles of the traffic rows shown (Element column). */
-async function titles(page) {
-  return page.locator('#traffic-table tbody tr td.title').allTextContents();
-}
-
 /** Bytes the console wrote to the port, and RTS changes, in order. */
 function wireLog(wire) {
   return wire.clients.flatMap((c) => c.log);
@@ -284,34 +271,7 @@ test('WebSerial: grant the scripted port, connect at 57600, RTS drives T_REQ, pi
 test('WebSerial: read, change, write and read back the PHY configuration', async (t) => {
   const { page } = await open(t);
   await connectSerial(page);
-  await tab(page, 'modem');
-  const card = page.locator('#mib-01');
-  const status = card.locator('[data-role=status]');
-  await card.locator('[data-action=read]').click();
-  await status.filter({ hasText: 'read from the modem' }).waitFor();
-  const freq = card.locator('input[name=high_frequency]');
-  assert.equal(await freq.inputValue(), '86000');
-
-  await freq.fill('110000');
-  await card.locator('input[name=tx_gain]').fill('20');
-  await card.locator('[data-action=write]').click();
-  await status.filter({ hasText: 'written and read back: the modem has it' }).waitFor();
-
-  await card.locator('[data-action=read]').click();
-  await status.filter({ hasText: 'read from the modem' }).waitFor();
-  assert.equal(await freq.inputValue(), '110000');
-  assert.equal(await card.locator('input[name=tx_gain]').inputValue(), '20');
-  assert.match(
-    await card.locator('[data-role=diff]').textContent(),
-    /2 field\(s\) differ from the factory default: High frequency, TX gain/,
-  );
-  await shot(page, 'webserial-modem');
-
-  await tab(page, 'traffic');
-  await page.selectOption('#filter-command', 'MIB_WriteRequest');
-  const rows = page.locator('#traffic-table tbody tr');
-  assert.equal(await rows.count(), 1);
-  assert.match(await rows.first().textContent(), /high_frequency=110000/);
+  await phyRoundTrip(page, 'webserial-modem');
 });
 
 test('WebSerial: a DL frame to the echoing peer comes back as a DL_DataIndication', async (t) => {
@@ -337,18 +297,8 @@ test('WebSerial: an out-of-range frequency is refused in the form and nothing is
   // Let the link settle (the reset indication's ACK), then count.
   await page.waitForTimeout(200);
   const sent = wireLog(wire).length;
-  const card = page.locator('#mib-01');
-  await card.locator('input[name=high_frequency]').fill('200000');
-  await card.locator('[data-action=write]').click();
-  const reason = card.locator('tr[data-field=high_frequency] [data-role=problem]');
-  await reason.filter({ hasText: '200000 is out of range 3000..=148500 Hz' }).waitFor();
-  assert.ok(await reason.isVisible());
-  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
-  // Give a wrongly sent request time to reach the port, then look.
-  await page.waitForTimeout(300);
+  await refusedFrequency(page, 'webserial-modem-refused');
   assert.deepEqual(wireLog(wire).slice(sent), [], 'not a byte, not an RTS change on the port');
-  await tab(page, 'traffic');
-  assert.ok(!(await titles(page)).includes('MIB_WriteRequest'));
 });
 
 test('WebSerial: unplugged mid-command, the console says so, nothing is stuck, and it reconnects', async (t) => {
@@ -428,27 +378,8 @@ test('WebSerial: the traffic log exports to JSON Lines and imports again', async
   const { page } = await open(t);
   await connectSerial(page);
   await ping(page);
-  await tab(page, 'traffic');
-  await page.click('#traffic-pause');
-  const before = await titles(page);
-  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#traffic-export')]);
-  assert.equal(download.suggestedFilename(), 'plm-traffic.jsonl');
-  const file = path.join(artifacts, 'webserial-traffic.jsonl');
-  await download.saveAs(file);
-  const lines = (await fs.readFile(file, 'utf8')).trim().split('\n');
-  assert.equal(lines.length, before.length);
-  const entries = lines.map((l) => JSON.parse(l));
-  for (const e of entries) {
-    assert.equal(typeof e.time_us, 'number');
-    assert.match(e.hex, /^([0-9a-f]{2})+$/);
-  }
+  const entries = await exportImport(page, 'webserial-traffic.jsonl');
   assert.ok(entries.some((e) => e.command === 'PingConfirm' && e.from === 'modem'));
-
-  await page.click('#traffic-clear');
-  assert.equal(await page.locator('#traffic-table tbody tr').count(), 0);
-  await page.setInputFiles('#traffic-import', file);
-  await page.locator('#traffic-message', { hasText: `Imported ${lines.length} elements` }).waitFor();
-  assert.deepEqual(await titles(page), before);
 });
 
 test('a browser without WebSerial is told so plainly, and the simulated modem still works', async (t) => {
