@@ -267,9 +267,11 @@ impl St7580 {
 
     /// The next UART output for the host.
     pub fn poll_transmit(&mut self) -> Option<Vec<u8>> {
-        match self.engine.poll_transmit()? {
-            Transmit::Bytes(b) => Some(b),
-            Transmit::TReq { .. } => Some(Vec::new()),
+        // The device side only writes bytes; T_REQ is the host's line.
+        loop {
+            if let Transmit::Bytes(b) = self.engine.poll_transmit()? {
+                return Some(b);
+            }
         }
     }
 
