@@ -173,6 +173,8 @@ test('a DL frame to an echoing peer comes back as a DL_DataIndication', async (t
     .locator('#data-result', { hasText: 'nothing sent: TX frequency: 200000 is out of range' })
     .waitFor();
   await page.selectOption('#data-frequency', 'high');
+  await page.locator('#snr-plot-empty', { hasText: 'No indications yet' }).waitFor();
+  assert.equal(await page.locator('#snr-plot').count(), 0, 'no empty chart');
 
   await page.fill('#data-payload', 'hello street');
   await page.click('#data-send');
@@ -180,6 +182,17 @@ test('a DL frame to an echoing peer comes back as a DL_DataIndication', async (t
   const row = page.locator('#indications-table tbody tr', { hasText: 'DL_DataIndication' });
   await row.first().waitFor({ timeout: 5_000 });
   assert.match(await row.first().textContent(), /68 65 6c 6c 6f 20 73 74 72 65 65 74/);
+  // The SNR plot has a DL marker for it, whose hover text is the table's SNR.
+  const marker = page.locator('#snr-plot circle.snr-point.kind-dl');
+  await marker.first().waitFor();
+  assert.ok((await page.locator('#snr-plot .snr-point').count()) >= 1);
+  const snr = (await row.first().locator('td').nth(5).textContent()).trim();
+  assert.match(snr, /^-?\d+$/);
+  assert.match(
+    await marker.first().locator('title').textContent(),
+    new RegExp(`^\\d+\\.\\d{6} s: DL_DataIndication, SNR ${snr} dB$`),
+  );
+  assert.equal(await page.locator('#snr-plot-empty').count(), 0);
   await shot(page, 'data');
   await tab(page, 'simulator');
   await page.locator('#sim-events li', { hasText: 'node 1 hears node 0' }).first().waitFor();

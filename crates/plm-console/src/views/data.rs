@@ -3,6 +3,7 @@
 //! decoded; and the power line frames received (data and sniffer
 //! indications) as plm-core decoded them in the traffic log.
 
+use super::snr_plot::{self, Point};
 use super::{millis, seconds, spaced};
 use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
@@ -47,6 +48,15 @@ fn payload(e: &Entry) -> String {
     .map(|k| field(e, k))
     .find(|p| !p.is_empty())
     .unwrap_or_default()
+}
+
+/// The SNR of each indication, in log order. Left out: B-FSK frames (SNR
+/// byte 255, "no meaning", decoded as null: UM0932 Table 39) and entries
+/// imported without a time.
+fn snr_points(rows: &[Entry]) -> Vec<Point> {
+    rows.iter()
+        .filter_map(|e| Point::new(e.at?, field(e, "snr").parse().ok()?, &e.title()))
+        .collect()
 }
 
 /// The view.
@@ -340,6 +350,27 @@ fn Indications() -> impl IntoView {
             <p class="muted">
                 "Data and sniffer indications from the modem (UM0932 Table 39). With echoing peers (Simulator view) every frame sent comes back."
             </p>
+            {move || {
+                rows.with(|r| match snr_plot::layout(&snr_points(r)) {
+                    Some(plot) => snr_plot::draw(plot).into_any(),
+                    None if r.is_empty() => {
+                        view! {
+                            <p class="muted" id="snr-plot-empty">
+                                "No indications yet: send a frame with echoing peers (Simulator view)."
+                            </p>
+                        }
+                            .into_any()
+                    }
+                    None => {
+                        view! {
+                            <p class="muted" id="snr-plot-empty">
+                                "No SNR to plot: B-FSK frames carry none, and imported entries may have no time."
+                            </p>
+                        }
+                            .into_any()
+                    }
+                })
+            }}
             <table class="log" id="indications-table">
                 <thead>
                     <tr>
@@ -410,6 +441,45 @@ mod tests {
         assert_eq!(r.params.tx_frequency, Some(110_000));
         assert_eq!(r.params.tx_gain, Some(20));
         assert_eq!(r.payload, b"hi");
+    }
+
+    #[test]
+    fn snr_points_are_the_signed_snr_of_timed_indications() {
+        use crate::traffic::TrafficLog;
+        use plm_core::decode::decode_all;
+        use plm_core::link::{Dialect, Source};
+        use plm_core::st7580::{DataIndication, IndicationInfo};
+        let indication = |modulation, snr: u8| {
+            let info = IndicationInfo {
+                modulation,
+                snr,
+                ..IndicationInfo::default()
+            };
+            let c = Command::DlDataIndication(DataIndication {
+                info,
+                payload: b"hi".to_vec(),
+            });
+            let bytes = c.to_frame().emit(Dialect::St7580).unwrap();
+            decode_all(Dialect::St7580, Source::Modem, &bytes)
+        };
+        let mut log = TrafficLog::default();
+        for d in indication(Modulation::QPsk, (-3i8) as u8) {
+            log.push(Some(2_500_000), d);
+        }
+        // B-FSK: SNR byte 255, no meaning (UM0932 Table 39).
+        for d in indication(Modulation::BFsk, 0xFF) {
+            log.push(Some(3_000_000), d);
+        }
+        // No time (imported).
+        for d in indication(Modulation::BPsk, 7) {
+            log.push(None, d);
+        }
+        let rows: Vec<Entry> = log.iter().cloned().collect();
+        let points = snr_points(&rows);
+        assert_eq!(points.len(), 1, "{points:?}");
+        assert_eq!(points[0].at, 2_500_000);
+        assert_eq!(points[0].snr_db, -3);
+        assert_eq!(points[0].kind, snr_plot::Kind::Dl);
     }
 
     #[test]

@@ -9,6 +9,7 @@ pub mod files;
 pub mod modem;
 pub mod serial_port;
 pub mod simulator;
+pub mod snr_plot;
 pub mod traffic;
 
 use plm_core::time::Instant;
