@@ -11,6 +11,10 @@ use std::time::SystemTime;
 /// Trunk 0.22 needs a newer rustc than the workspace's 1.95 (DESIGN.md).
 pub const TRUNK_VERSION: &str = "0.21.14";
 const WASM_TARGET: &str = "wasm32-unknown-unknown";
+/// Debian's Chromium, which every browser test drives.
+pub const CHROMIUM: &str = "/usr/bin/chromium";
+/// Debian's ChromeDriver, through which wasm-bindgen-test-runner drives it.
+pub const CHROMEDRIVER: &str = "/usr/bin/chromedriver";
 
 /// Runs every setup step; with `dry_run`, only says what it would do.
 pub fn run(dry_run: bool) -> Result {
@@ -151,14 +155,11 @@ fn quoted(s: &str) -> Option<String> {
 
 fn chromium(dry_run: bool) -> Result {
     let what = "chromium and chromium-driver (browser tests)";
-    let missing: Vec<&str> = [
-        ("chromium", "/usr/bin/chromium"),
-        ("chromium-driver", "/usr/bin/chromedriver"),
-    ]
-    .into_iter()
-    .filter(|(_, path)| !Path::new(path).exists())
-    .map(|(package, _)| package)
-    .collect();
+    let missing: Vec<&str> = [("chromium", CHROMIUM), ("chromium-driver", CHROMEDRIVER)]
+        .into_iter()
+        .filter(|(_, path)| !Path::new(path).exists())
+        .map(|(package, _)| package)
+        .collect();
     if missing.is_empty() {
         return already(what);
     }

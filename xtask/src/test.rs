@@ -59,16 +59,41 @@ fn suites() -> Vec<Step> {
     ];
 
     if root.join("crates/plm-console").exists() {
+        // The console's browser-only code (WebSerial, its tests) exists on
+        // wasm32 alone, so it is linted there too.
         steps.push(Step::cmd(
-            "plm-console on wasm32",
+            "plm-console on wasm32 (clippy)",
             cargo(&[
-                "build",
+                "clippy",
                 "-p",
                 "plm-console",
                 "--target",
                 "wasm32-unknown-unknown",
+                "--all-targets",
+                "--",
+                "-D",
+                "warnings",
             ]),
         ));
+        // wasm-bindgen-test suites of both transports, in headless Chromium
+        // through ChromeDriver (both from `cargo xtask setup`); the runner
+        // is `.cargo/config.toml`'s, from the pinned wasm-bindgen-cli.
+        let console = root.join("crates/plm-console");
+        let browser = cargo(&[
+            "test",
+            "-p",
+            "plm-console",
+            "--target",
+            "wasm32-unknown-unknown",
+            "--tests",
+        ])
+        .env("CHROMEDRIVER", setup::CHROMEDRIVER)
+        .env(
+            "WASM_BINDGEN_TEST_WEBDRIVER_JSON",
+            &console.join("webdriver.json").to_string_lossy(),
+        )
+        .env("WASM_BINDGEN_TEST_TIMEOUT", "180");
+        steps.push(Step::cmd("console transports in Chromium", browser));
     } else {
         println!("test: no console wasm build yet (crates/plm-console absent)");
     }

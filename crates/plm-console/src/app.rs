@@ -84,6 +84,7 @@ pub fn App() -> impl IntoView {
     // The simulated modem is there at once, so the page is useful on any
     // machine (DESIGN.md).
     console.connect_simulated(1);
+    crate::bench_hook::install(console);
     if let Ok(handle) = set_interval_with_handle(move || console.tick(), TICK) {
         on_cleanup(move || handle.clear());
     }

@@ -1,6 +1,7 @@
 //! PLM Console: the browser console for ST power line modems.
 //!
-//! - [`transport`]: byte transports with T_REQ (the simulated modem).
+//! - [`transport`]: byte transports with T_REQ (the simulated modem,
+//!   WebSerial).
 //! - [`session`]: plm-core's host link engine over a transport, requests
 //!   matched with their answers.
 //! - [`traffic`]: the inspector's bounded, filterable, exportable log.

@@ -217,6 +217,11 @@ pub struct Session {
     duplicate_of: Option<(u8, Instant)>,
     /// Page time (µs) at which the transport's clock read 0.
     origin: Option<f64>,
+    /// Added to the transport's clock in every [`Note`]: the times of one
+    /// connection carry on from where the last one stopped, so the log
+    /// never runs backwards when the transport changes (the simulator's
+    /// clock starts at 0, WebSerial's is the page's).
+    log_offset: i64,
     /// The page's clock at the current tick, on the transport's clock.
     page_now: Instant,
     ack_times: AckTimes,
@@ -235,6 +240,7 @@ impl Session {
             active: None,
             duplicate_of: None,
             origin: None,
+            log_offset: 0,
             page_now: 0,
             ack_times: AckTimes::default(),
             out: Tick::default(),
@@ -262,13 +268,17 @@ impl Session {
     }
 
     /// Replaces the transport (or disconnects with `None`); every request
-    /// not yet answered fails with a message saying so.
+    /// not yet answered fails, with the reason the old transport was lost
+    /// if it was, else a message saying it was closed.
     pub fn replace_transport(&mut self, transport: Option<Box<dyn Transport>>) {
-        let why = "the connection was closed before the modem answered";
-        for (reply, outcome) in self.drop_requests(why) {
-            self.out.replies.push((reply, outcome));
-        }
+        let why = match self.state() {
+            LinkState::Disconnected(why) if self.transport.is_some() => why,
+            _ => "the connection was closed before the modem answered".to_string(),
+        };
+        self.fail_requests(&why);
+        let ended = self.log_time(self.now());
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
+        self.log_offset = ended as i64 - transport.as_ref().map_or(0, |t| t.now()) as i64;
         self.host = host_engine(baud);
         self.decoder = Decoder::new(Dialect::St7580, Source::Any);
         self.transport = transport;
@@ -326,8 +336,13 @@ impl Session {
     }
 
     /// Lets the transport's time catch up with the page's clock `page_us`
-    /// (µs, any origin) and returns what happened.
+    /// (µs, any origin) and returns what happened. While the transport is
+    /// down, requests fail at once with its reason instead of waiting for
+    /// the link's timeouts.
     pub fn tick(&mut self, page_us: f64) -> Tick {
+        if let (LinkState::Disconnected(why), true) = (self.state(), self.outstanding() > 0) {
+            self.fail_requests(&why);
+        }
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
             let origin = *self.origin.get_or_insert(page_us - start as f64);
             let mut target = (page_us - origin).max(0.0) as Instant;
@@ -440,7 +455,7 @@ impl Session {
         let mut decoded = self.decoder.decode(element);
         decoded.from = Some(from.to_string());
         self.out.notes.push(Note::Traffic {
-            at,
+            at: self.log_time(at),
             decoded: Box::new(decoded),
         });
     }
@@ -450,7 +465,8 @@ impl Session {
             Event::Received(el) => {
                 if let Element::Status(s) = &el {
                     if let Some(&byte) = s.data().first() {
-                        self.out.notes.push(Note::Status { at: now, byte });
+                        let at = self.log_time(now);
+                        self.out.notes.push(Note::Status { at, byte });
                     }
                 }
                 self.traffic(now, &el, "modem");
@@ -493,7 +509,7 @@ impl Session {
                     a.repeated |= cause == LinkError::NoAck;
                 }
                 self.out.notes.push(Note::Retry {
-                    at: now,
+                    at: self.log_time(now),
                     attempt,
                     cause: cause.to_string(),
                 });
@@ -538,7 +554,7 @@ impl Session {
             self.set_timeouts(Timeouts::default());
         }
         self.out.notes.push(Note::Unsolicited {
-            at: now,
+            at: self.log_time(now),
             command,
             duplicate,
         });
@@ -566,15 +582,30 @@ impl Session {
         self.out.notes.push(Note::Timeouts(timeouts));
     }
 
-    fn drop_requests(&mut self, why: &str) -> Vec<(Reply, Outcome)> {
-        let mut out = Vec::new();
+    /// A time on the transport's clock as the notes give it.
+    fn log_time(&self, t: Instant) -> Instant {
+        (t as i64).saturating_add(self.log_offset).max(0) as Instant
+    }
+
+    /// Fails every request not yet answered with `why`, and starts the
+    /// link engine afresh so that nothing of theirs is repeated later.
+    fn fail_requests(&mut self, why: &str) {
         if let Some(a) = self.active.take() {
-            out.push((a.reply, Outcome::Failed(why.to_string())));
+            self.out
+                .replies
+                .push((a.reply, Outcome::Failed(why.to_string())));
+            self.host = HostEngine::new(Dialect::St7580, self.host.config());
+            if let Some(t) = self.transport.as_mut() {
+                t.set_treq(false);
+            }
+            self.out.notes.push(Note::TReq(false));
         }
         for q in self.queue.drain(..) {
-            out.push((q.reply, Outcome::Failed(why.to_string())));
+            self.out
+                .replies
+                .push((q.reply, Outcome::Failed(why.to_string())));
         }
-        out
+        self.duplicate_of = None;
     }
 }
 
@@ -592,7 +623,6 @@ fn host_engine(baud: u32) -> HostEngine {
 mod tests {
     use super::*;
     use crate::transport::sim::SimTransport;
-    use plm_core::link::host::LinkError;
     use plm_sim::Fault;
     use std::cell::RefCell;
     use std::rc::Rc;
@@ -711,22 +741,51 @@ mod tests {
                 "the simulated cable is unplugged: plug it back in (Simulator view)".into()
             )]
         );
-        // Unplugged while the request is in flight: the link gives up.
-        s.transport_mut()
-            .and_then(|t| t.simulator())
-            .expect("simulated")
-            .inject(Fault::Plug);
+        // Unplugged while the request is in flight: it fails at the next
+        // tick with the reason, not seconds later at the link's timeouts.
+        fn inject(s: &mut Session, fault: Fault) {
+            let t = s.transport_mut().expect("a transport");
+            t.simulator().expect("simulated").inject(fault);
+        }
+        inject(&mut s, Fault::Plug);
         s.request(Command::PingRequest { data: vec![] }, reply(&seen));
-        s.transport_mut()
-            .and_then(|t| t.simulator())
-            .expect("simulated")
-            .inject(Fault::Unplug);
-        run(&mut s, &mut page, 3_000, &mut notes);
-        assert_eq!(
-            seen.borrow()[1],
-            Outcome::Failed(LinkError::NoStatus.to_string())
+        inject(&mut s, Fault::Unplug);
+        run(&mut s, &mut page, 4, &mut notes);
+        assert_eq!(seen.borrow().len(), 2);
+        assert_eq!(seen.borrow()[1], seen.borrow()[0]);
+        assert_eq!(s.outstanding(), 0);
+        // Plugged back in, the next request goes through from scratch.
+        inject(&mut s, Fault::Plug);
+        s.request(Command::PingRequest { data: vec![5] }, reply(&seen));
+        run(&mut s, &mut page, 200, &mut notes);
+        assert!(
+            matches!(&seen.borrow()[2], Outcome::Answer { command: Command::PingConfirm { data }, .. } if data == &[5]),
+            "{:?}",
+            seen.borrow()[2]
         );
-        assert!(notes.iter().any(|n| matches!(n, Note::Retry { .. })));
+    }
+
+    #[test]
+    fn the_log_time_carries_on_across_a_change_of_transport() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (0.0, Vec::new());
+        run(&mut s, &mut page, 400, &mut notes);
+        let last = |notes: &[Note]| {
+            notes.iter().rev().find_map(|n| match n {
+                Note::Traffic { at, .. } => Some(*at),
+                _ => None,
+            })
+        };
+        let first_run = last(&notes).expect("the reset indication");
+        // A new simulated modem: its clock starts at 0 again.
+        s.replace_transport(Some(Box::new(SimTransport::new(1, 57_600, 8))));
+        let mut after = Vec::new();
+        run(&mut s, &mut page, 40, &mut after);
+        let second = last(&after).expect("its reset indication");
+        assert!(
+            second > 400 * MS && second > first_run,
+            "{second} after {first_run}"
+        );
     }
 
     #[test]

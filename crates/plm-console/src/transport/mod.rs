@@ -2,9 +2,9 @@
 //!
 //! A transport moves bytes and the T_REQ line, and says what time it is;
 //! it knows nothing of frames. The [`crate::session`] drives plm-core's
-//! host link engine over it. Two kinds are planned (DESIGN.md): the
-//! simulated modem in the page ([`sim::SimTransport`], the default) and
-//! WebSerial to real hardware (not built yet).
+//! host link engine over it. Two kinds (DESIGN.md): the simulated modem
+//! in the page ([`sim::SimTransport`], the default) and a real modem over
+//! WebSerial (`webserial::WebSerialTransport`, wasm32 only).
 
 pub mod sim;
 /// WebSerial exists only in the browser (web-sys unstable APIs, wasm32).

@@ -1,4 +1,5 @@
-//! The connection bar, always visible: state, transport and port, baud,
+//! The connection bar, always visible: state, transport (with the
+//! WebSerial port chooser) and port, baud,
 //! chip, T_REQ level and the link's timeouts.
 
 use crate::stores::use_console;
@@ -6,29 +7,12 @@ use crate::transport::LinkState;
 use leptos::prelude::*;
 use plm_sim::BAUD_RATES;
 
-/// Whether the browser offers WebSerial (`navigator.serial`).
-fn has_web_serial() -> bool {
-    web_sys::window()
-        .map(|w| js_sys::Reflect::has(&w.navigator(), &"serial".into()).unwrap_or(false))
-        .unwrap_or(false)
-}
-
 /// The bar.
 #[component]
 pub fn ConnectionBar() -> impl IntoView {
     let c = use_console();
     let conn = c.conn;
     let connected = move || conn.state.with(LinkState::is_connected);
-    let serial_note = if has_web_serial() {
-        "WebSerial: a later release"
-    } else {
-        "WebSerial: not in this browser"
-    };
-    let serial_title = if has_web_serial() {
-        "Real modems over WebSerial come in a later release; the simulated modem works now."
-    } else {
-        "This browser has no WebSerial (navigator.serial): use Chrome or Edge for a real modem. The simulated modem works here."
-    };
     view! {
         <div class="conn" id="connection" aria-label="Connection">
             <span
@@ -42,13 +26,20 @@ pub fn ConnectionBar() -> impl IntoView {
             >
                 {move || if connected() { "● Connected" } else { "○ Disconnected" }}
             </span>
-            <label>
+            <span
+                class="item"
+                id="conn-transport"
+                title="Where the bytes go: the simulated modem in this page, or a real modem over WebSerial (the button beside it)"
+            >
                 "Transport "
-                <select id="transport" title=serial_title>
-                    <option value="sim" selected>"Simulated modem"</option>
-                    <option value="serial" disabled>{serial_note}</option>
-                </select>
-            </label>
+                <b>
+                    {move || match conn.kind.get().as_str() {
+                        "" => "none".to_string(),
+                        "Simulated" => "simulated modem".to_string(),
+                        other => other.to_string(),
+                    }}
+                </b>
+            </span>
             <crate::views::serial_port::SerialPort/>
             <span class="item" id="conn-port" title="Port">{move || conn.port.get()}</span>
             <label>

@@ -15,9 +15,6 @@ use plm_core::time::MS;
 /// The view.
 #[component]
 pub fn DiagnosticsView() -> impl IntoView {
-    // This view is mounted once, for the page's life (every view stays
-    // mounted): a good place for the benchmark's hook.
-    crate::bench_hook::install(use_console());
     view! {
         <div class="cards">
             <PingCard/>
