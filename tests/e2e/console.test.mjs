@@ -139,7 +139,7 @@ test('the traffic log exports to JSON Lines and imports again', async (t) => {
   assert.equal(ping.fields.data, '504c4d21');
 });
 
-test('the simulator unplugs the cable, the console says so, and recovers', async (t) => {
+test('the simulator unplugs the cable and corrupts a byte; the console says so, and recovers', async (t) => {
   const page = await open(t, '#simulator');
   await page.selectOption('#sim-nodes', '2');
   await page.click('#sim-apply-topology');
@@ -156,6 +156,18 @@ test('the simulator unplugs the cable, the console says so, and recovers', async
   await tab(page, 'diagnostics');
   await page.click('#ping-send');
   await page.locator('#ping-result', { hasText: 'PingConfirm' }).waitFor();
+  assert.equal(await page.locator('#conn-retries').count(), 0, 'no repeats yet');
+
+  // One byte of the next request corrupted on its way to the modem: the
+  // modem NAKs it, the link repeats it (UM0932 3.2.7), the ping still
+  // gets its answer, and the connection bar counts the repeat.
+  await tab(page, 'simulator');
+  await page.click('#sim-corrupt');
+  await tab(page, 'diagnostics');
+  await page.fill('#ping-payload', '0a 0b');
+  await page.click('#ping-send');
+  await page.locator('#ping-result', { hasText: 'PingConfirm' }).filter({ hasText: '0a 0b' }).waitFor();
+  assert.equal(await page.textContent('#conn-retries b'), '1');
 });
 
 test('a DL frame to an echoing peer comes back as a DL_DataIndication', async (t) => {

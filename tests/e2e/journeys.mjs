@@ -52,9 +52,17 @@ export async function phyRoundTrip(page, shotName) {
 
   await tab(page, 'traffic');
   await page.selectOption('#filter-command', 'MIB_WriteRequest');
+  // One write; the link repeats the same frame only when an attempt went
+  // wrong (UM0932 3.2.7), which a loaded machine can cause, and then the
+  // connection bar counts the repeats.
   const rows = page.locator('#traffic-table tbody tr');
-  assert.equal(await rows.count(), 1);
-  assert.match(await rows.first().textContent(), /high_frequency=110000/);
+  const sent = await rows.count();
+  assert.ok(sent >= 1, 'the MIB_WriteRequest is in the log');
+  for (const row of await rows.all()) assert.match(await row.textContent(), /high_frequency=110000/);
+  if (sent > 1) {
+    const repeats = Number(await page.textContent('#conn-retries b'));
+    assert.ok(repeats >= sent - 1, `${sent} requests sent with ${repeats} repeats`);
+  }
 }
 
 /**

@@ -1,6 +1,6 @@
 //! The connection bar, always visible: state, transport (with the
 //! WebSerial port chooser) and port, baud,
-//! chip, T_REQ level and the link's timeouts.
+//! chip, T_REQ level, the link's repeats and its timeouts.
 
 use crate::stores::use_console;
 use crate::transport::LinkState;
@@ -71,6 +71,20 @@ pub fn ConnectionBar() -> impl IntoView {
                     {move || if conn.treq.get() { "low" } else { "high" }}
                 </b>
             </span>
+            <Show when=move || conn.retries.get() != 0>
+                <span
+                    class="item warn"
+                    id="conn-retries"
+                    title=move || {
+                        format!(
+                            "Frames the link had to repeat since connecting (UM0932 3.2.7: NAK, no ACK, no status message). Last: {}",
+                            conn.last_problem.get().unwrap_or_default(),
+                        )
+                    }
+                >
+                    "Repeats " <b>{move || conn.retries.get()}</b>
+                </span>
+            </Show>
             <span class="item muted" title="Host-interface timeouts (MIB 09h)">
                 {move || {
                     let t = conn.timeouts.get();
