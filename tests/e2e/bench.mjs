@@ -19,7 +19,7 @@
 import fs from 'node:fs/promises';
 import path from 'node:path';
 import zlib from 'node:zlib';
-import { artifacts, dist, launchChromium, serveDist } from './harness.mjs';
+import { artifacts, dist, launchChromium, serveDist, pageErrors } from './harness.mjs';
 
 const READS = Number(process.env.PLM_BENCH_READS ?? 300);
 const WARM_UP = 20;
@@ -78,9 +78,7 @@ async function main() {
   const browser = await launchChromium();
   try {
     const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
-    const errors = [];
-    page.on('pageerror', (e) => errors.push(String(e)));
-    page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+    const errors = pageErrors(page);
 
     await page.goto(base + '#diagnostics');
     await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });

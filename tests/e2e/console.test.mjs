@@ -8,7 +8,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import path from 'node:path';
-import { artifacts, launchChromium, serveDist } from './harness.mjs';
+import { artifacts, launchChromium, serveDist, pageErrors } from './harness.mjs';
 import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 
 
@@ -34,11 +34,7 @@ async function open(t, hash = '') {
     viewport: { width: 1400, height: 900 },
   });
   const page = await context.newPage();
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(String(e)));
-  page.on('console', (m) => {
-    if (m.type() === 'error') errors.push(m.text());
-  });
+  const errors = pageErrors(page);
   t.after(async () => {
     await context.close();
     assert.deepEqual(errors, [], 'no errors in the page');

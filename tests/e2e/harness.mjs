@@ -68,3 +68,16 @@ export function launchChromium() {
     ],
   });
 }
+
+/**
+ * Every error the page reports (uncaught exceptions and console errors),
+ * collected from now on: the array fills as they come.
+ */
+export function pageErrors(page) {
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+  });
+  return errors;
+}

@@ -10,7 +10,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import path from 'node:path';
-import { dist, launchChromium, serveDist } from './harness.mjs';
+import { dist, launchChromium, serveDist, pageErrors } from './harness.mjs';
 import { shot, tab } from './journeys.mjs';
 
 let server;
@@ -48,11 +48,7 @@ after(async () => {
 test('once visited, the console works offline, and it is installable', async (t) => {
   const context = await browser.newContext({ viewport: { width: 1400, height: 900 } });
   const page = await context.newPage();
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(String(e)));
-  page.on('console', (m) => {
-    if (m.type() === 'error') errors.push(m.text());
-  });
+  const errors = pageErrors(page);
   t.after(async () => {
     await context.close();
     assert.deepEqual(errors, [], 'no errors in the page');

@@ -19,7 +19,7 @@ import path from 'node:path';
 import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { launchChromium, serveDist } from './harness.mjs';
+import { launchChromium, serveDist, pageErrors } from './harness.mjs';
 import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
@@ -161,11 +161,7 @@ async function open(t, { nodes = 2 } = {}) {
   await context.addInitScript({ path: shim });
   const page = await context.newPage();
   wire.attach(page);
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(String(e)));
-  page.on('console', (m) => {
-    if (m.type() === 'error') errors.push(m.text());
-  });
+  const errors = pageErrors(page);
   t.after(async () => {
     await context.close();
     for (const c of wire.clients) c.close();
@@ -388,8 +384,7 @@ test('a browser without WebSerial is told so plainly, and the simulated modem st
     delete Navigator.prototype.serial;
   });
   const page = await context.newPage();
-  const errors = [];
-  page.on('pageerror', (e) => errors.push(String(e)));
+  const errors = pageErrors(page);
   t.after(async () => {
     await context.close();
     assert.deepEqual(errors, [], 'no errors in the page');
