@@ -340,8 +340,10 @@ impl Session {
     /// down, requests fail at once with its reason instead of waiting for
     /// the link's timeouts.
     pub fn tick(&mut self, page_us: f64) -> Tick {
-        if let (LinkState::Disconnected(why), true) = (self.state(), self.outstanding() > 0) {
-            self.fail_requests(&why);
+        if self.outstanding() > 0 {
+            if let LinkState::Disconnected(why) = self.state() {
+                self.fail_requests(&why);
+            }
         }
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
             let origin = *self.origin.get_or_insert(page_us - start as f64);
