@@ -8,7 +8,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import path from 'node:path';
-import { artifacts, launchChromium, serveDist, pageErrors } from './harness.mjs';
+import { artifacts, launchChromium, serveDist, watchedPage } from './harness.mjs';
 import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 
 
@@ -33,12 +33,7 @@ async function open(t, hash = '') {
     acceptDownloads: true,
     viewport: { width: 1400, height: 900 },
   });
-  const page = await context.newPage();
-  const errors = pageErrors(page);
-  t.after(async () => {
-    await context.close();
-    assert.deepEqual(errors, [], 'no errors in the page');
-  });
+  const page = await watchedPage(t, context);
   await page.goto(base + hash);
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   return page;

@@ -3,6 +3,7 @@
 // driven by playwright-core with the flags this machine's closed network
 // needs (see /work/.library/env: no background networking).
 
+import assert from 'node:assert/strict';
 import http from 'node:http';
 import fs from 'node:fs/promises';
 import path from 'node:path';
@@ -80,4 +81,18 @@ export function pageErrors(page) {
     if (m.type() === 'error') errors.push(m.text());
   });
   return errors;
+}
+
+/**
+ * A new page in `context`; after the test `t` the context is closed and
+ * the test fails if the page reported an error.
+ */
+export async function watchedPage(t, context) {
+  const page = await context.newPage();
+  const errors = pageErrors(page);
+  t.after(async () => {
+    await context.close();
+    assert.deepEqual(errors, [], 'no errors in the page');
+  });
+  return page;
 }

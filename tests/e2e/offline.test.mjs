@@ -10,7 +10,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import path from 'node:path';
-import { dist, launchChromium, serveDist, pageErrors } from './harness.mjs';
+import { dist, launchChromium, serveDist, watchedPage } from './harness.mjs';
 import { shot, tab } from './journeys.mjs';
 
 let server;
@@ -47,12 +47,7 @@ after(async () => {
 
 test('once visited, the console works offline, and it is installable', async (t) => {
   const context = await browser.newContext({ viewport: { width: 1400, height: 900 } });
-  const page = await context.newPage();
-  const errors = pageErrors(page);
-  t.after(async () => {
-    await context.close();
-    assert.deepEqual(errors, [], 'no errors in the page');
-  });
+  const page = await watchedPage(t, context);
 
   // First visit: the page registers web/sw.js, which caches the build and
   // takes control of this very page (clients.claim).

@@ -19,7 +19,7 @@ import path from 'node:path';
 import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { launchChromium, serveDist, pageErrors } from './harness.mjs';
+import { launchChromium, serveDist, pageErrors, watchedPage } from './harness.mjs';
 import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
@@ -383,12 +383,7 @@ test('a browser without WebSerial is told so plainly, and the simulated modem st
   await context.addInitScript(() => {
     delete Navigator.prototype.serial;
   });
-  const page = await context.newPage();
-  const errors = pageErrors(page);
-  t.after(async () => {
-    await context.close();
-    assert.deepEqual(errors, [], 'no errors in the page');
-  });
+  const page = await watchedPage(t, context);
   await page.goto(base);
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   assert.equal(await page.textContent('#serial-toggle'), 'WebSerial: not in this browser');

@@ -197,33 +197,9 @@ fn LineCard() -> impl IntoView {
             <p class="muted">
                 "TX level 100 dBµV at full gain, 30 dB between neighbours, 2 dB more per node in between."
             </p>
-            <label>
-                "Noise floor (dBµV) "
-                <input
-                    id="sim-noise"
-                    size="5"
-                    prop:value=move || noise.get()
-                    on:input=move |ev| noise.set(event_target_value(&ev))
-                />
-            </label>
-            <label>
-                "Frame loss (%) "
-                <input
-                    id="sim-loss"
-                    size="4"
-                    prop:value=move || loss.get()
-                    on:input=move |ev| loss.set(event_target_value(&ev))
-                />
-            </label>
-            <label>
-                "Corruption (%) "
-                <input
-                    id="sim-corruption"
-                    size="4"
-                    prop:value=move || corruption.get()
-                    on:input=move |ev| corruption.set(event_target_value(&ev))
-                />
-            </label>
+            <TextField label="Noise floor (dBµV) " id="sim-noise" size=5 value=noise/>
+            <TextField label="Frame loss (%) " id="sim-loss" size=4 value=loss/>
+            <TextField label="Corruption (%) " id="sim-corruption" size=4 value=corruption/>
             <button id="sim-apply-line" on:click=apply>"Apply"</button>
             <p class="muted">{move || message.get()}</p>
         </article>
@@ -298,18 +274,9 @@ fn UartCard() -> impl IntoView {
                 </button>
             </div>
             <p class="muted">"At random, for every byte this way:"</p>
-            <label>
-                "drop % "
-                <input size="4" id="sim-p-drop" prop:value=move || drop.get() on:input=move |ev| drop.set(event_target_value(&ev))/>
-            </label>
-            <label>
-                "corrupt % "
-                <input size="4" id="sim-p-corrupt" prop:value=move || corrupt.get() on:input=move |ev| corrupt.set(event_target_value(&ev))/>
-            </label>
-            <label>
-                "delay % "
-                <input size="4" id="sim-p-delay" prop:value=move || delay.get() on:input=move |ev| delay.set(event_target_value(&ev))/>
-            </label>
+            <TextField label="drop % " id="sim-p-drop" size=4 value=drop/>
+            <TextField label="corrupt % " id="sim-p-corrupt" size=4 value=corrupt/>
+            <TextField label="delay % " id="sim-p-delay" size=4 value=delay/>
             <button id="sim-apply-uart" on:click=apply>"Apply"</button>
             <p class="muted">{move || message.get()}</p>
         </article>
@@ -341,5 +308,26 @@ fn LineEventsCard() -> impl IntoView {
                 }
             }}
         </article>
+    }
+}
+
+/// A labelled text input bound to `value` (checked when applied).
+#[component]
+fn TextField(
+    label: &'static str,
+    id: &'static str,
+    size: u32,
+    value: RwSignal<String>,
+) -> impl IntoView {
+    view! {
+        <label>
+            {label}
+            <input
+                id=id
+                size=size
+                prop:value=move || value.get()
+                on:input=move |ev| value.set(event_target_value(&ev))
+            />
+        </label>
     }
 }
