@@ -4,6 +4,8 @@
 //! the ST power line modems' host interfaces lives here, once, and the
 //! console, the simulator and the `plm` tool all call it.
 //!
+//! - [`app`]: the street-light controller board's application layer
+//!   (STEVAL-IHP007V1): frames, service and HID commands, the concentrator.
 //! - [`link`]: local frames, checksum, ACK/NAK, status messages, the stream
 //!   decoder and the sans-IO host and device link engines (UM0932 3.2).
 //! - [`st7580`]: every ST7580 command (UM0932 3.3) and MIB object (UM0932 4).
@@ -20,6 +22,7 @@ extern crate alloc;
 #[cfg(test)]
 extern crate std;
 
+pub mod app;
 pub mod decode;
 pub mod field;
 pub mod hex;

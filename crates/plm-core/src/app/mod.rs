@@ -1,0 +1,38 @@
+//! The street-light controller board's application layer
+//! (STEVAL-IHP007V1 user manual, seed 004): what the console, `plm board`
+//! and the simulated boards say to each other.
+//!
+//! - [`frame`]: application frames on the board's USART, addresses,
+//!   frame types; [`crc`]: their CRC-16.
+//! - [`message`]: a frame's payload typed ([`Message`]) and the answer a
+//!   request waits for; [`service`] and [`hid`]: the one description of
+//!   every service command and HID ballast parameter; [`error`]: error
+//!   codes in words.
+//! - [`line`]: how a frame travels over the power line in a DL frame.
+//! - [`usart`]: the USART stream decoder; [`requester`]: requests and
+//!   answers, timeouts and retries; [`concentrator`]: both over a board's
+//!   USART or a bare ST7580.
+//!
+//! Decisions where the seed is silent are in docs/protocol-notes.md
+//! ("STEVAL-IHP007V1 application layer").
+
+pub mod concentrator;
+pub mod crc;
+pub mod error;
+pub mod frame;
+pub mod hid;
+pub mod line;
+pub mod message;
+pub mod requester;
+pub mod service;
+pub mod usart;
+
+pub use concentrator::{Carrier, Concentrator, Happening};
+pub use error::ErrorCode;
+pub use frame::{Address, AppFrame, FrameError, FrameType};
+pub use hid::{Ballast, Hid, LampState};
+pub use line::LineFrame;
+pub use message::{Expect, Message, MessageError};
+pub use requester::{AppEvent, Request, RequestId, Requester, RequesterConfig};
+pub use service::{Clock, Discovered, Release, Service};
+pub use usart::{UsartDecoder, UsartElement};

@@ -1,0 +1,745 @@
+//! Service commands (STEVAL-IHP007V1 UM 4.5 `APP_SER_CMD_t`, 4.6.4): the
+//! one description of each command's request and answer, and the typed
+//! [`Service`] the simulator and the console use. A service frame's
+//! payload is `[command, data...]`; the offsets below count from the
+//! first data byte.
+//!
+//! Requests and replies of one command always differ in length, so a
+//! frame is read without knowing which way it went.
+
+use super::error::ErrorCode;
+use crate::field::{self, Field, FieldError};
+use alloc::vec::Vec;
+use core::fmt;
+
+/// Programming groups (`APP_PROG_GROUP_t`), index = value.
+pub const PROG_GROUPS: &[&str] = &[
+    "PROG_GRP_DEVICE_DATA",
+    "PROG_GRP_LL_STACK_PARAM",
+    "PROG_GRP_USER_DATA",
+];
+/// Bytes of one parameter group (4.6.4 "Set module parameters":
+/// buffer[10 -> 41], 32 bytes; the same size for every group, see
+/// protocol notes).
+pub const PARAM_LEN: usize = 32;
+/// Highest SNR value of SERVICE_SN_SET/GET ("SNR Ratio from 0 to 31").
+pub const SNR_MAX: u8 = 31;
+/// First code of the user-defined service range ("0x0b to 0x7f";
+/// 0Bh-10h are taken by the native commands that follow in the enum).
+pub const USER_FIRST: u8 = 0x11;
+
+/// What answers a request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Answer {
+    /// Nothing (the resets: "Any response from PLM module" read as none).
+    None,
+    /// An APP_ACK_FRAME echoing the service frame type and the command.
+    Ack,
+    /// A service frame of the same command with this data.
+    Reply(&'static [Field], usize),
+    /// Not described yet (the RFU commands' layouts come with RFU).
+    Undefined,
+}
+
+/// One service command.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ServiceDesc {
+    /// Command code.
+    pub code: u8,
+    /// The seed's name (`SERVICE_PLM_CLOCK_SET`).
+    pub name: &'static str,
+    /// What it does, in words.
+    pub what: &'static str,
+    /// Request data layout.
+    pub request: &'static [Field],
+    /// Request data length; `None` for any length.
+    pub request_len: Option<usize>,
+    /// What answers it.
+    pub answer: Answer,
+}
+
+/// Field layouts of the service data.
+pub mod fields {
+    use super::*;
+    /// Programming group.
+    pub const GROUP: Field =
+        Field::enumeration("group", "Programming group", 0, 0, 8, PROG_GROUPS).range(0, 2);
+    /// Parameter block after the group.
+    pub const PARAMETERS: Field = Field::bytes("parameters", "Parameters", 1, PARAM_LEN);
+    /// GPIO input pins, bit x = IOx.
+    pub const INPUTS: Field = Field::uint("inputs", "Inputs", 0, 1);
+    /// GPIO output pins, bit x = IOx.
+    pub const OUTPUTS: Field = Field::uint("outputs", "Outputs", 0, 1);
+    /// GPIO direction: bit x = 1 -> IOx output, 0 -> input.
+    pub const IO_CONFIG: Field = Field::uint("io_configuration", "I/O configuration", 0, 1);
+    /// Module firmware release x.y.
+    pub const FIRMWARE_MAJOR: Field = Field::uint("firmware_major", "Firmware release x", 0, 1);
+    /// Module firmware release x.y.
+    pub const FIRMWARE_MINOR: Field = Field::uint("firmware_minor", "Firmware release y", 1, 1);
+    /// Stack firmware release x.y.
+    pub const STACK_MAJOR: Field = Field::uint("stack_major", "Stack release x", 2, 1);
+    /// Stack firmware release x.y.
+    pub const STACK_MINOR: Field = Field::uint("stack_minor", "Stack release y", 3, 1);
+    /// Clock hours.
+    pub const HOURS: Field = Field::uint("hours", "Hours", 0, 1).range(0, 23).unit("h");
+    /// Clock minutes.
+    pub const MINUTES: Field = Field::uint("minutes", "Minutes", 1, 1)
+        .range(0, 59)
+        .unit("min");
+    /// Clock seconds.
+    pub const SECONDS: Field = Field::uint("seconds", "Seconds", 2, 1)
+        .range(0, 59)
+        .unit("s");
+    /// SNR ratio 0-31.
+    pub const SNR: Field = Field::uint("snr", "SNR ratio", 0, 1)
+        .range(0, SNR_MAX as i64)
+        .unit("dB");
+    /// Discovery session: a board answers once per session (protocol notes).
+    pub const SESSION: Field = Field::uint("session", "Discovery session", 0, 1);
+    /// Discovery reply window: boards answer at a random moment in it.
+    pub const WINDOW: Field = Field::uint("window", "Reply window", 1, 1)
+        .range(1, 60)
+        .unit("s");
+    /// Discovery reply: SNR at which the board heard the request.
+    pub const DISCOVERY_SNR: Field = Field::uint("snr", "SNR of the request", 4, 1)
+        .range(0, SNR_MAX as i64)
+        .unit("dB");
+    /// Bytes not yet described (RFU, user commands).
+    pub const DATA: Field = Field::bytes("data", "Data", 0, 0);
+
+    /// PARAM_SET request.
+    pub const PARAM_SET: &[Field] = &[GROUP, PARAMETERS];
+    /// PARAM_GET request.
+    pub const PARAM_GET: &[Field] = &[GROUP];
+    /// FW_REL_GET reply.
+    pub const RELEASES: &[Field] = &[FIRMWARE_MAJOR, FIRMWARE_MINOR, STACK_MAJOR, STACK_MINOR];
+    /// CLOCK_SET request, CLOCK_GET reply.
+    pub const CLOCK: &[Field] = &[HOURS, MINUTES, SECONDS];
+    /// NET_DISCOVER_REQ request.
+    pub const DISCOVER: &[Field] = &[SESSION, WINDOW];
+    /// NET_DISCOVER_REQ reply.
+    pub const DISCOVERED: &[Field] = &[
+        FIRMWARE_MAJOR,
+        FIRMWARE_MINOR,
+        STACK_MAJOR,
+        STACK_MINOR,
+        DISCOVERY_SNR,
+    ];
+}
+
+use fields as f;
+
+/// Every native service command (4.5, 4.6.4), by code.
+pub const COMMANDS: &[ServiceDesc] = &[
+    ServiceDesc {
+        code: 0x00,
+        name: "SERVICE_SOFTWARE_RESET",
+        what: "Reset the board's state machines",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::None,
+    },
+    ServiceDesc {
+        code: 0x01,
+        name: "SERVICE_HARDWARE_RESET",
+        what: "Reset the board",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::None,
+    },
+    ServiceDesc {
+        code: 0x02,
+        name: "SERVICE_PARAM_SET",
+        what: "Write a parameter group",
+        request: f::PARAM_SET,
+        request_len: Some(1 + PARAM_LEN),
+        answer: Answer::Ack,
+    },
+    ServiceDesc {
+        code: 0x03,
+        name: "SERVICE_PARAM_GET",
+        what: "Read a parameter group",
+        request: f::PARAM_GET,
+        request_len: Some(1),
+        answer: Answer::Reply(f::PARAM_SET, 1 + PARAM_LEN),
+    },
+    ServiceDesc {
+        code: 0x04,
+        name: "SERVICE_INPUTS_GET",
+        what: "Read the GPIO inputs",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::Reply(&[f::INPUTS], 1),
+    },
+    ServiceDesc {
+        code: 0x05,
+        name: "SERVICE_OUTPUTS_SET",
+        what: "Set the GPIO outputs",
+        request: &[f::OUTPUTS],
+        request_len: Some(1),
+        answer: Answer::Ack,
+    },
+    ServiceDesc {
+        code: 0x06,
+        name: "SERVICE_FW_REL_GET",
+        what: "Read the firmware and stack releases",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::Reply(f::RELEASES, 4),
+    },
+    ServiceDesc {
+        code: 0x07,
+        name: "SERVICE_PLM_CLOCK_SET",
+        what: "Set the board's clock",
+        request: f::CLOCK,
+        request_len: Some(3),
+        answer: Answer::Ack,
+    },
+    ServiceDesc {
+        code: 0x08,
+        name: "SERVICE_PLM_CLOCK_GET",
+        what: "Read the board's clock",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::Reply(f::CLOCK, 3),
+    },
+    ServiceDesc {
+        code: 0x09,
+        name: "SERVICE_IO_CONFIG_SET",
+        what: "Set which GPIO pins are outputs",
+        request: &[f::IO_CONFIG],
+        request_len: Some(1),
+        answer: Answer::Ack,
+    },
+    ServiceDesc {
+        code: 0x0a,
+        name: "SERVICE_IO_CONFIG_GET",
+        what: "Read which GPIO pins are outputs",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::Reply(&[f::IO_CONFIG], 1),
+    },
+    ServiceDesc {
+        code: 0x0b,
+        name: "SERVICE_NET_DISCOVER_REQ",
+        what: "Discover the boards on the line",
+        request: f::DISCOVER,
+        request_len: Some(2),
+        answer: Answer::Reply(f::DISCOVERED, 5),
+    },
+    ServiceDesc {
+        code: 0x0c,
+        name: "SERVICE_RFU_SET_IMG_HEADER",
+        what: "Remote firmware update: image header",
+        request: &[f::DATA],
+        request_len: None,
+        answer: Answer::Undefined,
+    },
+    ServiceDesc {
+        code: 0x0d,
+        name: "SERVICE_RFU_SET_IMG_DATA",
+        what: "Remote firmware update: image segment",
+        request: &[f::DATA],
+        request_len: None,
+        answer: Answer::Undefined,
+    },
+    ServiceDesc {
+        code: 0x0e,
+        name: "SERVICE_RFU_SWAP_IMG",
+        what: "Remote firmware update: check and boot the new image",
+        request: &[f::DATA],
+        request_len: None,
+        answer: Answer::Undefined,
+    },
+    ServiceDesc {
+        code: 0x0f,
+        name: "SERVICE_SN_SET",
+        what: "Set the SNR threshold",
+        request: &[f::SNR],
+        request_len: Some(1),
+        answer: Answer::Ack,
+    },
+    ServiceDesc {
+        code: 0x10,
+        name: "SERVICE_SN_GET",
+        what: "Read the SNR of the last frame the board heard",
+        request: &[],
+        request_len: Some(0),
+        answer: Answer::Reply(&[f::SNR], 1),
+    },
+];
+
+/// The description of a command code.
+pub fn describe(code: u8) -> Option<&'static ServiceDesc> {
+    COMMANDS.iter().find(|d| d.code == code)
+}
+
+/// A release `x.y`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
+pub struct Release {
+    /// x.
+    pub major: u8,
+    /// y.
+    pub minor: u8,
+}
+
+impl fmt::Display for Release {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}.{}", self.major, self.minor)
+    }
+}
+
+/// A time of day as the board's RTC keeps it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Clock {
+    /// 0-23.
+    pub hours: u8,
+    /// 0-59.
+    pub minutes: u8,
+    /// 0-59.
+    pub seconds: u8,
+}
+
+impl Clock {
+    /// Seconds since midnight.
+    pub fn seconds_of_day(self) -> u32 {
+        self.hours as u32 * 3600 + self.minutes as u32 * 60 + self.seconds as u32
+    }
+
+    /// The time `s` seconds after midnight (wrapping at 24 h).
+    pub fn from_seconds(s: u64) -> Clock {
+        let s = s % 86_400;
+        Clock {
+            hours: (s / 3600) as u8,
+            minutes: (s / 60 % 60) as u8,
+            seconds: (s % 60) as u8,
+        }
+    }
+}
+
+impl fmt::Display for Clock {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{:02}:{:02}:{:02}",
+            self.hours, self.minutes, self.seconds
+        )
+    }
+}
+
+/// What a board found by discovery says of itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Discovered {
+    /// Module firmware release.
+    pub firmware: Release,
+    /// Stack release.
+    pub stack: Release,
+    /// SNR at which it heard the request, dB (0-31).
+    pub snr: u8,
+}
+
+/// A service frame's payload, typed: requests and their replies.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Service {
+    /// 00h.
+    SoftwareReset,
+    /// 01h.
+    HardwareReset,
+    /// 02h.
+    ParamSet {
+        /// Programming group (0-2).
+        group: u8,
+        /// 32 bytes.
+        data: Vec<u8>,
+    },
+    /// 03h request.
+    ParamGet {
+        /// Programming group.
+        group: u8,
+    },
+    /// 03h reply.
+    Params {
+        /// Programming group.
+        group: u8,
+        /// 32 bytes.
+        data: Vec<u8>,
+    },
+    /// 04h request.
+    InputsGet,
+    /// 04h reply: bit x = IOx.
+    Inputs(u8),
+    /// 05h: bit x = IOx.
+    OutputsSet(u8),
+    /// 06h request.
+    FwRelGet,
+    /// 06h reply.
+    FwRel {
+        /// Module firmware.
+        firmware: Release,
+        /// Stack.
+        stack: Release,
+    },
+    /// 07h.
+    ClockSet(Clock),
+    /// 08h request.
+    ClockGet,
+    /// 08h reply.
+    ClockNow(Clock),
+    /// 09h: bit x = 1 -> IOx output.
+    IoConfigSet(u8),
+    /// 0Ah request.
+    IoConfigGet,
+    /// 0Ah reply.
+    IoConfig(u8),
+    /// 0Bh request.
+    Discover {
+        /// Session number: a board acknowledged in a session answers no
+        /// more requests of it.
+        session: u8,
+        /// Reply window, s.
+        window: u8,
+    },
+    /// 0Bh reply.
+    DiscoverReply(Discovered),
+    /// 0Fh.
+    SnSet(u8),
+    /// 10h request.
+    SnGet,
+    /// 10h reply.
+    Sn(u8),
+    /// A command whose layout is not described (RFU 0Ch-0Eh until the
+    /// RFU protocol, user-defined commands), kept as bytes.
+    Raw {
+        /// Command code.
+        command: u8,
+        /// Its data.
+        data: Vec<u8>,
+    },
+}
+
+/// Why a service payload does not fit its command.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ServiceError {
+    /// No command byte.
+    Empty,
+    /// The data length fits neither request nor reply.
+    Length {
+        /// Command name.
+        name: &'static str,
+        /// Request length.
+        request: usize,
+        /// Reply length, if there is a reply.
+        reply: Option<usize>,
+        /// What came.
+        got: usize,
+    },
+    /// A field is out of range.
+    Field(FieldError),
+}
+
+impl fmt::Display for ServiceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ServiceError::Empty => f.write_str("a service frame needs a command byte"),
+            ServiceError::Length {
+                name,
+                request,
+                reply,
+                got,
+            } => {
+                write!(f, "{name} carries {request} data bytes")?;
+                if let Some(r) = reply {
+                    write!(f, " (its reply {r})")?;
+                }
+                write!(f, ", not {got}")
+            }
+            ServiceError::Field(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl ServiceError {
+    /// The error code a board answers with (4.5).
+    pub fn code(&self) -> ErrorCode {
+        ErrorCode::SERVICE_CMD_ERROR
+    }
+}
+
+fn get(f: &Field, d: &[u8]) -> u8 {
+    f.get(d).unwrap_or(0) as u8
+}
+
+fn release(d: &[u8], major: &Field, minor: &Field) -> Release {
+    Release {
+        major: get(major, d),
+        minor: get(minor, d),
+    }
+}
+
+fn clock(d: &[u8]) -> Clock {
+    Clock {
+        hours: get(&f::HOURS, d),
+        minutes: get(&f::MINUTES, d),
+        seconds: get(&f::SECONDS, d),
+    }
+}
+
+impl Service {
+    /// Reads a service payload `[command, data...]`. Field ranges are
+    /// not checked here (see [`Service::validate`]): a sniffer shows what
+    /// was sent.
+    pub fn parse(payload: &[u8]) -> Result<Service, ServiceError> {
+        let (&command, d) = payload.split_first().ok_or(ServiceError::Empty)?;
+        let Some(desc) = describe(command) else {
+            return Ok(Service::Raw {
+                command,
+                data: d.to_vec(),
+            });
+        };
+        let reply_len = match desc.answer {
+            Answer::Reply(_, n) => Some(n),
+            _ => None,
+        };
+        let is_request = desc.request_len.is_none_or(|n| n == d.len());
+        let is_reply = reply_len == Some(d.len());
+        if !is_request && !is_reply {
+            return Err(ServiceError::Length {
+                name: desc.name,
+                request: desc.request_len.unwrap_or(0),
+                reply: reply_len,
+                got: d.len(),
+            });
+        }
+        let group = || get(&f::GROUP, d);
+        let params = || d[1..].to_vec();
+        Ok(match (command, is_request) {
+            (0x00, _) => Service::SoftwareReset,
+            (0x01, _) => Service::HardwareReset,
+            (0x02, _) => Service::ParamSet {
+                group: group(),
+                data: params(),
+            },
+            (0x03, true) => Service::ParamGet { group: group() },
+            (0x03, false) => Service::Params {
+                group: group(),
+                data: params(),
+            },
+            (0x04, true) => Service::InputsGet,
+            (0x04, false) => Service::Inputs(get(&f::INPUTS, d)),
+            (0x05, _) => Service::OutputsSet(get(&f::OUTPUTS, d)),
+            (0x06, true) => Service::FwRelGet,
+            (0x06, false) => Service::FwRel {
+                firmware: release(d, &f::FIRMWARE_MAJOR, &f::FIRMWARE_MINOR),
+                stack: release(d, &f::STACK_MAJOR, &f::STACK_MINOR),
+            },
+            (0x07, _) => Service::ClockSet(clock(d)),
+            (0x08, true) => Service::ClockGet,
+            (0x08, false) => Service::ClockNow(clock(d)),
+            (0x09, _) => Service::IoConfigSet(get(&f::IO_CONFIG, d)),
+            (0x0a, true) => Service::IoConfigGet,
+            (0x0a, false) => Service::IoConfig(get(&f::IO_CONFIG, d)),
+            (0x0b, true) => Service::Discover {
+                session: get(&f::SESSION, d),
+                window: get(&f::WINDOW, d),
+            },
+            (0x0b, false) => Service::DiscoverReply(Discovered {
+                firmware: release(d, &f::FIRMWARE_MAJOR, &f::FIRMWARE_MINOR),
+                stack: release(d, &f::STACK_MAJOR, &f::STACK_MINOR),
+                snr: get(&f::DISCOVERY_SNR, d),
+            }),
+            (0x0f, _) => Service::SnSet(get(&f::SNR, d)),
+            (0x10, true) => Service::SnGet,
+            (0x10, false) => Service::Sn(get(&f::SNR, d)),
+            _ => Service::Raw {
+                command,
+                data: d.to_vec(),
+            },
+        })
+    }
+
+    /// The command code.
+    pub fn command(&self) -> u8 {
+        use Service::*;
+        match self {
+            SoftwareReset => 0x00,
+            HardwareReset => 0x01,
+            ParamSet { .. } => 0x02,
+            ParamGet { .. } | Params { .. } => 0x03,
+            InputsGet | Inputs(_) => 0x04,
+            OutputsSet(_) => 0x05,
+            FwRelGet | FwRel { .. } => 0x06,
+            ClockSet(_) => 0x07,
+            ClockGet | ClockNow(_) => 0x08,
+            IoConfigSet(_) => 0x09,
+            IoConfigGet | IoConfig(_) => 0x0a,
+            Discover { .. } | DiscoverReply(_) => 0x0b,
+            SnSet(_) => 0x0f,
+            SnGet | Sn(_) => 0x10,
+            Raw { command, .. } => *command,
+        }
+    }
+
+    /// The description of its command, if the seed describes it.
+    pub fn desc(&self) -> Option<&'static ServiceDesc> {
+        describe(self.command())
+    }
+
+    /// Whether this is a request (and not a reply).
+    pub fn is_request(&self) -> bool {
+        use Service::*;
+        !matches!(
+            self,
+            Params { .. }
+                | Inputs(_)
+                | FwRel { .. }
+                | ClockNow(_)
+                | IoConfig(_)
+                | DiscoverReply(_)
+                | Sn(_)
+        )
+    }
+
+    /// The payload `[command, data...]`.
+    pub fn payload(&self) -> Vec<u8> {
+        use Service::*;
+        let mut out = alloc::vec![self.command()];
+        match self {
+            SoftwareReset | HardwareReset | InputsGet | FwRelGet | ClockGet | IoConfigGet
+            | SnGet => {}
+            ParamSet { group, data } | Params { group, data } => {
+                out.push(*group);
+                out.extend_from_slice(data);
+            }
+            ParamGet { group } => out.push(*group),
+            Inputs(v) | OutputsSet(v) | IoConfigSet(v) | IoConfig(v) | SnSet(v) | Sn(v) => {
+                out.push(*v)
+            }
+            FwRel { firmware, stack } => {
+                out.extend_from_slice(&[firmware.major, firmware.minor, stack.major, stack.minor])
+            }
+            ClockSet(c) | ClockNow(c) => out.extend_from_slice(&[c.hours, c.minutes, c.seconds]),
+            Discover { session, window } => out.extend_from_slice(&[*session, *window]),
+            DiscoverReply(r) => out.extend_from_slice(&[
+                r.firmware.major,
+                r.firmware.minor,
+                r.stack.major,
+                r.stack.minor,
+                r.snr,
+            ]),
+            Raw { data, .. } => out.extend_from_slice(data),
+        }
+        out
+    }
+
+    /// The data layout of this request or reply.
+    pub fn layout(&self) -> &'static [Field] {
+        match (self.desc(), self.is_request()) {
+            (Some(d), true) => d.request,
+            (
+                Some(ServiceDesc {
+                    answer: Answer::Reply(l, _),
+                    ..
+                }),
+                false,
+            ) => l,
+            _ => &[f::DATA],
+        }
+    }
+
+    /// The checks a board applies (ranges, lengths), with the reason in
+    /// words; the console refuses a request that fails them before
+    /// anything is sent.
+    pub fn validate(&self) -> Result<(), ServiceError> {
+        let payload = self.payload();
+        let data = &payload[1..];
+        if let Some(desc) = self.desc() {
+            let want = if self.is_request() {
+                desc.request_len
+            } else if let Answer::Reply(_, n) = desc.answer {
+                Some(n)
+            } else {
+                None
+            };
+            if want.is_some_and(|n| n != data.len()) {
+                return Err(ServiceError::Length {
+                    name: desc.name,
+                    request: desc.request_len.unwrap_or(0),
+                    reply: None,
+                    got: data.len(),
+                });
+            }
+        }
+        field::validate(self.layout(), data).map_err(ServiceError::Field)
+    }
+
+    /// What answers this request.
+    pub fn answer(&self) -> Answer {
+        self.desc().map_or(Answer::Undefined, |d| d.answer)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::string::ToString;
+
+    #[test]
+    fn requests_and_replies_of_one_command_are_told_apart_by_length() {
+        assert_eq!(Service::parse(&[0x08]), Ok(Service::ClockGet));
+        assert_eq!(
+            Service::parse(&[0x08, 12, 30, 5]),
+            Ok(Service::ClockNow(Clock {
+                hours: 12,
+                minutes: 30,
+                seconds: 5
+            }))
+        );
+        assert!(matches!(
+            Service::parse(&[0x08, 1]),
+            Err(ServiceError::Length { .. })
+        ));
+    }
+
+    #[test]
+    fn clock_ranges_are_refused_in_words() {
+        let e = Service::ClockSet(Clock {
+            hours: 24,
+            minutes: 0,
+            seconds: 0,
+        })
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.to_string(), "hours: 24 is out of range 0..=23 h");
+        assert!(Service::SnSet(32).validate().is_err());
+        assert!(Service::ParamSet {
+            group: 2,
+            data: alloc::vec![0; 31]
+        }
+        .validate()
+        .is_err());
+        assert!(Service::ParamSet {
+            group: 3,
+            data: alloc::vec![0; 32]
+        }
+        .validate()
+        .is_err());
+        assert!(Service::ParamSet {
+            group: 2,
+            data: alloc::vec![0; 32]
+        }
+        .validate()
+        .is_ok());
+    }
+
+    #[test]
+    fn every_described_command_round_trips() {
+        for d in COMMANDS {
+            let data = alloc::vec![0; d.request_len.unwrap_or(3)];
+            let mut p = alloc::vec![d.code];
+            p.extend_from_slice(&data);
+            let s = Service::parse(&p).unwrap();
+            assert_eq!(s.payload(), p, "{}", d.name);
+            assert!(s.is_request(), "{}", d.name);
+        }
+    }
+}
