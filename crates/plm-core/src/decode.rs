@@ -7,7 +7,10 @@
 //! - frames: `stx`, `length`, `code`, `command` (the manual's name, `null`
 //!   for an unknown code), `checksum`, `checksum_ok`, and `fields` named
 //!   after the manual's labels in snake_case;
-//! - `error` when the data does not fit the command, `reason` for garbage.
+//! - `error` when the data does not fit the command, `reason` for garbage;
+//! - DL_DataRequest, DL_DataIndication and DL_SnifferIndication: `app` in
+//!   `fields`, the application frame the DL payload carries
+//!   ([`crate::decode_app`]), when it can be one.
 
 use crate::field::{Field, Value};
 use crate::hex;
@@ -72,7 +75,7 @@ pub fn json_value(v: &Value) -> Json {
     }
 }
 
-fn put_layout(map: &mut Map<String, Json>, layout: &'static [Field], data: &[u8]) {
+pub(crate) fn put_layout(map: &mut Map<String, Json>, layout: &'static [Field], data: &[u8]) {
     for (f, v) in crate::mib::describe(layout, data) {
         map.insert(f.name.to_string(), json_value(&v));
     }
@@ -252,6 +255,9 @@ impl Decoder {
             PhyDataRequest(r) | DlDataRequest(r) => {
                 put_tx_params(f, data, &r.params);
                 put_hex(f, "payload", &r.payload);
+                if matches!(cmd, DlDataRequest(_)) {
+                    put_app(f, &r.payload);
+                }
             }
             SsDataRequest(r) => {
                 put_tx_params(f, data, &r.params);
@@ -278,6 +284,9 @@ impl Decoder {
                     _ => "ss_sdu",
                 };
                 put_hex(f, key, &i.payload);
+                if matches!(cmd, DlDataIndication(_) | DlSnifferIndication(_)) {
+                    put_app(f, &i.payload);
+                }
             }
             CmdSyntaxError { error } => {
                 f.insert("error".into(), Json::from(*error));
@@ -308,6 +317,19 @@ fn put_object(f: &mut Map<String, Json>, index: u8, data: &[u8]) -> Option<Strin
     }
     put_layout(f, o.fields, data);
     None
+}
+
+/// The application frame a DL payload carries over the power line
+/// (`app::line`), under the key `app`, when the payload can be one. A
+/// sniffed frame's payload still ends with its wrong DL CRC, whose length
+/// the indication does not give: it shows as the last payload bytes.
+fn put_app(f: &mut Map<String, Json>, payload: &[u8]) {
+    if let Some(line) = crate::app::LineFrame::parse(payload) {
+        f.insert(
+            "app".into(),
+            crate::decode_app::decode_line(&line).to_json(),
+        );
+    }
 }
 
 fn put_tx_params(f: &mut Map<String, Json>, bytes: &[u8], p: &st7580::TxParams) {

@@ -14,6 +14,8 @@
 //! - [`mib`]: the declarative MIB description (objects, access, defaults).
 //! - [`decode`]: the named-field view of a stream element that `plm decode`
 //!   prints and the console's traffic inspector shows.
+//! - [`decode_app`]: the same view of the controller board's application
+//!   frames, on its USART and on the power line.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -24,6 +26,7 @@ extern crate std;
 
 pub mod app;
 pub mod decode;
+pub mod decode_app;
 pub mod field;
 pub mod hex;
 pub mod link;
