@@ -22,7 +22,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Decode host-interface bytes into JSON Lines, one object per frame,
-    /// ACK, NAK, status message or run of garbage.
+    /// ACK, NAK, status message or run of garbage; with --board, a
+    /// controller board's USART, one object per application frame or run
+    /// of garbage.
     Decode(DecodeArgs),
     /// Serve a simulated modem as an RFC 2217 (Telnet COM-PORT-OPTION)
     /// serial port: RTS drives T_REQ, SET-BAUDRATE the BR pins.
@@ -46,8 +48,12 @@ enum From {
 #[derive(clap::Args)]
 struct DecodeArgs {
     /// Which chip's host interface.
-    #[arg(long, value_enum)]
-    chip: Chip,
+    #[arg(long, value_enum, required_unless_present = "board")]
+    chip: Option<Chip>,
+    /// Decode a street-light controller board's USART instead: application
+    /// frames with CRC-16 (STEVAL-IHP007V1 UM 4.6).
+    #[arg(long, conflicts_with_all = ["chip", "from", "mib_index"])]
+    board: bool,
     /// Who sent the bytes (default: either).
     #[arg(long, value_enum)]
     from: Option<From>,
@@ -138,9 +144,20 @@ fn decode(args: DecodeArgs) -> Result<(), String> {
         args.hex.join(" ")
     };
     let bytes = plm_core::hex::parse(&text).map_err(|e| format!("input is not hex: {e}"))?;
+    let mut out = BufWriter::new(io::stdout().lock());
+    let mut print = |line: Result<String, serde_json::Error>| {
+        let line = line.map_err(|e| e.to_string())?;
+        writeln!(out, "{line}").map_err(|e| format!("cannot write: {e}"))
+    };
     let dialect = match args.chip {
-        Chip::St7580 => Dialect::St7580,
-        Chip::St7570 => Dialect::St7570,
+        Some(Chip::St7580) => Dialect::St7580,
+        Some(Chip::St7570) => Dialect::St7570,
+        None => {
+            for d in plm_core::decode_app::decode_usart(&bytes) {
+                print(serde_json::to_string(&d))?;
+            }
+            return out.flush().map_err(|e| format!("cannot write: {e}"));
+        }
     };
     let source = match args.from {
         Some(From::Host) => Source::Host,
@@ -153,10 +170,8 @@ fn decode(args: DecodeArgs) -> Result<(), String> {
     }
     decoder.push(&bytes);
     decoder.finish();
-    let mut out = BufWriter::new(io::stdout().lock());
     while let Some(d) = decoder.next() {
-        let line = serde_json::to_string(&d).map_err(|e| e.to_string())?;
-        writeln!(out, "{line}").map_err(|e| format!("cannot write: {e}"))?;
+        print(serde_json::to_string(&d))?;
     }
     out.flush().map_err(|e| format!("cannot write: {e}"))
 }
