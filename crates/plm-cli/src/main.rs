@@ -80,8 +80,17 @@ struct SimArgs {
     allow_remote: bool,
     /// Modems on the simulated power line: the served one and N-1 others
     /// that echo what they hear.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64))]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
     nodes: u16,
+    /// Serve a street-light concentrator board's USART (application
+    /// frames, no T_REQ) with a street of lamps behind it (12 unless
+    /// --street says otherwise).
+    #[arg(long)]
+    board: bool,
+    /// Put a street of N street-light boards on the power line, behind
+    /// the served modem (or the concentrator board with --board).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=500))]
+    street: Option<u16>,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -125,10 +134,21 @@ fn sim(args: SimArgs) -> Result<(), String> {
     if let Chip::St7570 = args.chip {
         return Err("the ST7570 is not simulated yet; use --chip st7580".into());
     }
+    let world = match (args.board, args.street) {
+        (true, n) => sim_server::World::Street {
+            lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),
+            attach: plm_sim::Attach::Board,
+        },
+        (false, Some(n)) => sim_server::World::Street {
+            lamps: n.into(),
+            attach: plm_sim::Attach::Modem,
+        },
+        (false, None) => sim_server::World::Modems(args.nodes.into()),
+    };
     sim_server::run(sim_server::Options {
         listen: args.listen,
         allow_remote: args.allow_remote,
-        nodes: args.nodes.into(),
+        world,
         seed: args.seed,
     })
 }

@@ -1,6 +1,9 @@
 //! `plm sim`: the simulated ST7580 served as a serial port over RFC 2217,
 //! so that any host software that speaks it (pyserial's `rfc2217://`,
-//! ser2net clients, the console's own TCP transport) can drive it.
+//! ser2net clients, the console's own TCP transport) can drive it; or,
+//! with `--board`, a street-light concentrator board's USART with a
+//! street of lamps behind it (application frames, RTS ignored: a board's
+//! USART has no T_REQ).
 //!
 //! One thread. The simulator runs in virtual microseconds; this loop maps
 //! wall-clock time since the first client connected onto it, advancing it
@@ -20,7 +23,7 @@
 //! When the client goes, T_REQ is released and the simulation goes on.
 
 use crate::rfc2217::{self, Action};
-use plm_sim::{Sim, SimConfig};
+use plm_sim::{Attach, Sim, SimConfig};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -35,11 +38,27 @@ const TICK: Duration = Duration::from_millis(1);
 /// The longest it sleeps when nothing is scheduled (only accepting, Ctrl-C).
 const IDLE: Duration = Duration::from_millis(20);
 
+/// Lamps on a street unless told otherwise (`--board` alone).
+pub const DEFAULT_STREET: usize = 12;
+
+/// What is simulated behind the served port.
+pub enum World {
+    /// Modems: the served one and N-1 echoing peers.
+    Modems(usize),
+    /// A street of lamps behind the served modem or concentrator board.
+    Street {
+        /// Street-light boards on the line.
+        lamps: usize,
+        /// What the client's bytes reach.
+        attach: Attach,
+    },
+}
+
 /// What `plm sim` was asked for.
 pub struct Options {
     pub listen: String,
     pub allow_remote: bool,
-    pub nodes: usize,
+    pub world: World,
     pub seed: u64,
 }
 
@@ -52,17 +71,38 @@ pub fn run(opts: Options) -> Result<(), String> {
     ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))
         .map_err(|e| format!("cannot catch Ctrl-C: {e}"))?;
 
+    let (config, what) = match opts.world {
+        World::Modems(nodes) => (
+            SimConfig {
+                nodes,
+                ..SimConfig::default()
+            },
+            format!("simulated ST7580 (node 0 of {nodes}"),
+        ),
+        World::Street { lamps, attach } => (
+            SimConfig::street(lamps, attach),
+            match attach {
+                Attach::Modem => format!("simulated ST7580 with a street of {lamps} lamps ("),
+                Attach::Board => {
+                    format!("simulated concentrator board's USART with a street of {lamps} lamps (")
+                }
+            },
+        ),
+    };
+    let greeting = match config.attach {
+        Attach::Modem => "plm sim: simulated ST7580, node 0",
+        Attach::Board => "plm sim: simulated street-light concentrator board (USART)",
+    };
     let mut sim = Sim::new(SimConfig {
         seed: opts.seed,
-        nodes: opts.nodes,
-        ..SimConfig::default()
+        ..config
     });
     println!(
-        "plm sim: simulated ST7580 (node 0 of {}, seed {}) as RFC 2217 on {addr} \
+        "plm sim: {what}, seed {}) as RFC 2217 on {addr} \
          — connect with e.g. pyserial rfc2217://{addr}",
-        opts.nodes, opts.seed
+        opts.seed
     );
-    println!("plm sim: the modems power on when the first client connects; Ctrl-C stops");
+    println!("plm sim: the simulation powers on when the first client connects; Ctrl-C stops");
 
     // Wall-clock time of simulated time 0.
     let mut origin: Option<Instant> = None;
@@ -73,7 +113,7 @@ pub fn run(opts: Options) -> Result<(), String> {
             Ok((stream, peer)) => {
                 let start = *origin.get_or_insert_with(Instant::now);
                 advance(&mut sim, start);
-                match Client::open(stream, peer, sim.baud()) {
+                match Client::open(stream, peer, sim.baud(), greeting) {
                     Ok(c) => {
                         println!("plm sim: client {peer} connected");
                         client = Some(c);
@@ -169,7 +209,12 @@ struct Client {
 }
 
 impl Client {
-    fn open(stream: TcpStream, peer: SocketAddr, baud: u32) -> std::io::Result<Client> {
+    fn open(
+        stream: TcpStream,
+        peer: SocketAddr,
+        baud: u32,
+        greeting: &'static str,
+    ) -> std::io::Result<Client> {
         stream.set_nonblocking(false)?;
         // Bytes go out as they come: Nagle's delay would eat T_ACK (40 ms).
         stream.set_nodelay(true)?;
@@ -177,7 +222,7 @@ impl Client {
         let mut c = Client {
             stream,
             peer,
-            telnet: rfc2217::Server::new("plm sim: simulated ST7580, node 0", baud, RATES),
+            telnet: rfc2217::Server::new(greeting, baud, RATES),
             held: Vec::new(),
         };
         let greeting = c.telnet.greeting();

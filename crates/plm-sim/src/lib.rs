@@ -17,20 +17,28 @@
 //! - [`line`]: the power line.
 //! - [`uart`]: a UART direction with fault injection.
 //! - [`echo`]: the echoing host of simulated peers.
+//! - [`ballast`]: the HID ballast of a board and its lamp model.
+//! - [`board`]: the street-light controller board (STEVAL-IHP007V1) whose
+//!   firmware drives its modem, and a concentrator board's USART.
 //! - [`drive`]: plm-core's host engine driving node 0 in virtual time.
+//! - [`street`]: plm-core's concentrator driving a street in virtual time.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod ballast;
+pub mod board;
 pub mod drive;
 pub mod echo;
 pub mod line;
 pub mod modem;
 pub mod rng;
 pub mod sim;
+pub mod street;
 pub mod uart;
 
 pub use drive::{HostDriver, Outcome};
 pub use line::LineConfig;
-pub use sim::{Dir, Fault, LineEvent, Sim, SimConfig};
+pub use sim::{Attach, Dir, Fault, LineEvent, Peers, Sim, SimConfig};
+pub use street::StreetDriver;
 pub use uart::{ByteFaults, BAUD_RATES};

@@ -1,11 +1,16 @@
 //! The simulation: modems, their UARTs and hosts, and the power line that
 //! joins them, run in virtual time from one event queue and one seeded RNG.
 //!
-//! Node 0's host is outside: the test, the console or `plm sim` writes its
-//! UART bytes and T_REQ through [`Sim::write`] and [`Sim::set_treq`] and
-//! reads what the modem sent with [`Sim::host_read`]. Every other node's
-//! host is an [`EchoHost`] that sends back what its modem hears.
+//! Node 0's host is outside: the test, the console or `plm sim` writes
+//! bytes and T_REQ through [`Sim::write`] and [`Sim::set_treq`] and reads
+//! what came back with [`Sim::host_read`]. What those bytes reach is
+//! [`Attach`]: node 0's modem (its host interface), or a concentrator
+//! [`Board`] (its USART). Every other node's host is an [`EchoHost`] that
+//! sends back what its modem hears, or, on a street ([`Peers::Street`]),
+//! a street-light [`Board`] with its lamp.
 
+use crate::ballast::BallastConfig;
+use crate::board::{street_address, Board, BoardConfig};
 use crate::echo::EchoHost;
 use crate::line::{self, LineConfig, Transmission};
 use crate::modem::{Reception, St7580};
@@ -30,6 +35,12 @@ pub struct SimConfig {
     pub baud: u32,
     /// Conditions on the power line.
     pub line: LineConfig,
+    /// What the outside host is wired to.
+    pub attach: Attach,
+    /// Who the other nodes' hosts are.
+    pub peers: Peers,
+    /// The lamps of a street's boards.
+    pub ballast: BallastConfig,
 }
 
 impl Default for SimConfig {
@@ -39,6 +50,69 @@ impl Default for SimConfig {
             nodes: 1,
             baud: 57_600,
             line: LineConfig::default(),
+            attach: Attach::Modem,
+            peers: Peers::Echo,
+            ballast: BallastConfig::default(),
+        }
+    }
+}
+
+impl SimConfig {
+    /// A street of `lamps` boards along the line behind node 0, reached
+    /// `via` a concentrator board's USART or a bare modem.
+    pub fn street(lamps: usize, via: Attach) -> SimConfig {
+        SimConfig {
+            nodes: lamps + 1,
+            line: LineConfig::street(lamps),
+            attach: via,
+            peers: Peers::Street,
+            ..SimConfig::default()
+        }
+    }
+}
+
+/// What the outside host's bytes reach on node 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Attach {
+    /// The ST7580's host interface (UM0932 3), with T_REQ.
+    Modem,
+    /// A concentrator board's USART (STEVAL UM 4.6): application frames,
+    /// no T_REQ; the board's firmware drives the modem.
+    Board,
+}
+
+/// Who the hosts of nodes 1.. are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Peers {
+    /// Echoing hosts (modem demos and tests).
+    Echo,
+    /// Street-light controller boards with their lamps.
+    Street,
+}
+
+/// Who drives a node's modem.
+#[derive(Debug, Clone)]
+enum Host {
+    /// The outside world (node 0 with [`Attach::Modem`]).
+    Outside,
+    Echo(Box<EchoHost>),
+    Board(Box<Board>),
+}
+
+impl Host {
+    fn poll_timeout(&self) -> Option<Instant> {
+        match self {
+            Host::Outside => None,
+            Host::Echo(e) => e.poll_timeout(),
+            Host::Board(b) => b.poll_timeout(),
+        }
+    }
+
+    fn poll_transmit(&mut self) -> Option<Transmit> {
+        match self {
+            Host::Outside => None,
+            Host::Echo(e) => e.poll_transmit(),
+            Host::Board(b) => b.poll_transmit(),
         }
     }
 }
@@ -124,11 +198,31 @@ const LINE_LOG: usize = 4_096;
 
 #[derive(Debug, Clone)]
 enum Ev {
-    ToModem { node: usize, byte: u8 },
-    ToHost { node: usize, byte: u8 },
-    Treq { node: usize, asserted: bool },
+    ToModem {
+        node: usize,
+        byte: u8,
+    },
+    ToHost {
+        node: usize,
+        byte: u8,
+    },
+    Treq {
+        node: usize,
+        asserted: bool,
+    },
+    /// Outside host to the concentrator board's USART.
+    ToUsart {
+        byte: u8,
+    },
+    /// The concentrator board's USART to the outside host.
+    FromUsart {
+        byte: u8,
+    },
     TxStart(Box<Transmission>),
-    RxEnd { node: usize, id: u64 },
+    RxEnd {
+        node: usize,
+        id: u64,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -173,8 +267,11 @@ struct Node {
     down: Wire,
     /// Modem to host.
     up: Wire,
-    app: Option<EchoHost>,
+    host: Host,
     rx: Vec<ActiveRx>,
+    /// Cut off the line (the board's supply off, its cable cut): it
+    /// neither hears nor is heard.
+    cut: bool,
 }
 
 /// The simulated modems and their power line.
@@ -190,6 +287,11 @@ pub struct Sim {
     plugged: bool,
     treq: bool,
     log: VecDeque<LineEvent>,
+    attach: Attach,
+    /// Outside host to the concentrator board's USART ([`Attach::Board`]).
+    usart_down: Wire,
+    /// The concentrator board's USART to the outside host.
+    usart_up: Wire,
 }
 
 impl Sim {
@@ -198,19 +300,49 @@ impl Sim {
     /// onto virtual time from the moment it creates the simulation (or
     /// from when its host is there to hear them).
     pub fn new(config: SimConfig) -> Sim {
+        let mut rng = Rng::new(config.seed);
         let nodes = (0..config.nodes.max(1))
-            .map(|i| Node {
-                modem: St7580::new(i, config.baud, 0, config.seed),
-                down: Wire::new(config.baud),
-                up: Wire::new(config.baud),
-                app: (i > 0).then(|| EchoHost::new(config.baud)),
-                rx: Vec::new(),
+            .map(|i| {
+                let board = |ballast, clock_offset| {
+                    Board::new(
+                        0,
+                        BoardConfig {
+                            address: street_address(i),
+                            ballast,
+                            baud: config.baud,
+                            clock_offset,
+                        },
+                    )
+                };
+                let host = match (i, config.attach, config.peers) {
+                    (0, Attach::Modem, _) => Host::Outside,
+                    (0, Attach::Board, _) => Host::Board(Box::new(board(None, 0).with_usart())),
+                    (_, _, Peers::Echo) => Host::Echo(Box::new(EchoHost::new(config.baud))),
+                    (_, _, Peers::Street) => {
+                        // Each board's RTC drifted up to 10 minutes; each
+                        // ballast has its own stream of chance.
+                        let offset = rng.below(600);
+                        let ballast = BallastConfig {
+                            seed: rng.next_u64(),
+                            ..config.ballast.clone()
+                        };
+                        Host::Board(Box::new(board(Some(ballast), offset)))
+                    }
+                };
+                Node {
+                    modem: St7580::new(i, config.baud, 0, config.seed),
+                    down: Wire::new(config.baud),
+                    up: Wire::new(config.baud),
+                    host,
+                    rx: Vec::new(),
+                    cut: false,
+                }
             })
             .collect();
         Sim {
             now: 0,
             seq: 0,
-            rng: Rng::new(config.seed),
+            rng,
             line: config.line,
             nodes,
             queue: BinaryHeap::new(),
@@ -218,7 +350,51 @@ impl Sim {
             plugged: true,
             treq: false,
             log: VecDeque::new(),
+            attach: config.attach,
+            usart_down: Wire::new(config.baud),
+            usart_up: Wire::new(config.baud),
         }
+    }
+
+    /// What the outside host is wired to.
+    pub fn attach(&self) -> Attach {
+        self.attach
+    }
+
+    /// The board of `node`, if a board drives that node's modem.
+    pub fn board(&self, node: usize) -> Option<&Board> {
+        match &self.nodes.get(node)?.host {
+            Host::Board(b) => Some(b),
+            _ => None,
+        }
+    }
+
+    /// Acts on the board of `node` now (fail or repair its lamp, ...).
+    pub fn with_board<R>(
+        &mut self,
+        node: usize,
+        f: impl FnOnce(&mut Board, Instant) -> R,
+    ) -> Option<R> {
+        let now = self.now;
+        let r = match &mut self.nodes.get_mut(node)?.host {
+            Host::Board(b) => Some(f(b, now)),
+            _ => None,
+        };
+        self.flush();
+        r
+    }
+
+    /// Cuts `node` off the line, or joins it again: a board whose supply
+    /// is off neither hears nor answers (an unreachable node).
+    pub fn set_cut(&mut self, node: usize, cut: bool) {
+        if let Some(n) = self.nodes.get_mut(node) {
+            n.cut = cut;
+        }
+    }
+
+    /// Whether `node` is cut off the line.
+    pub fn is_cut(&self, node: usize) -> bool {
+        self.nodes.get(node).is_some_and(|n| n.cut)
     }
 
     /// Virtual time now, µs.
@@ -238,7 +414,10 @@ impl Sim {
 
     /// Data indications the host of `node` has echoed (0 for node 0).
     pub fn echoed(&self, node: usize) -> u64 {
-        self.nodes[node].app.as_ref().map_or(0, |a| a.echoed)
+        match &self.nodes[node].host {
+            Host::Echo(e) => e.echoed,
+            _ => 0,
+        }
     }
 
     /// Configures a MIB object of `node` directly, as its host would have
@@ -251,7 +430,7 @@ impl Sim {
     /// e.g. a data request: peers can talk first, not only echo.
     pub fn peer_request(&mut self, node: usize, cmd: &Command) {
         let now = self.now;
-        if let Some(app) = self.nodes.get_mut(node).and_then(|n| n.app.as_mut()) {
+        if let Some(Host::Echo(app)) = self.nodes.get_mut(node).map(|n| &mut n.host) {
             app.submit(now, cmd);
         }
         self.flush();
@@ -300,23 +479,40 @@ impl Sim {
         self.plugged
     }
 
-    /// Node 0's UART baud rate.
+    /// The outside host's UART baud rate.
     pub fn baud(&self) -> u32 {
-        self.nodes[0].down.baud()
+        match self.attach {
+            Attach::Modem => self.nodes[0].down.baud(),
+            Attach::Board => self.usart_down.baud(),
+        }
     }
 
     /// Sets node 0's UART baud rate, both ways and at the modem (its
-    /// BR0/BR1 pins strapped to match the host, see protocol notes).
+    /// BR0/BR1 pins strapped to match the host, see protocol notes); with
+    /// a concentrator board, its USART's.
     pub fn set_baud(&mut self, baud: u32) {
+        if self.attach == Attach::Board {
+            self.usart_down.set_baud(baud);
+            self.usart_up.set_baud(baud);
+            return;
+        }
         let n = &mut self.nodes[0];
         n.down.set_baud(baud);
         n.up.set_baud(baud);
         n.modem.set_baud(baud);
     }
 
-    /// The host writes `bytes` to node 0's UART now.
+    /// The host writes `bytes` to node 0's UART (or the concentrator
+    /// board's USART) now.
     pub fn write(&mut self, bytes: &[u8]) {
         if !self.plugged {
+            return;
+        }
+        if self.attach == Attach::Board {
+            let arrivals = self.usart_down.write(self.now, bytes, &mut self.rng);
+            for (at, byte) in arrivals {
+                self.schedule(at, Ev::ToUsart { byte });
+            }
             return;
         }
         let arrivals = self.nodes[0].down.write(self.now, bytes, &mut self.rng);
@@ -329,6 +525,9 @@ impl Sim {
     /// bytes written before have left the UART, as a driver drains its
     /// FIFO before touching RTS.
     pub fn set_treq(&mut self, asserted: bool) {
+        if self.attach == Attach::Board {
+            return; // a board's USART has no T_REQ (STEVAL UM 4.6)
+        }
         self.treq = asserted;
         let at = self.nodes[0].down.drained_at(self.now);
         self.schedule(at, Ev::Treq { node: 0, asserted });
@@ -350,7 +549,7 @@ impl Sim {
         let mut d = self.queue.peek().map(|s| s.0.at);
         for n in &self.nodes {
             d = earliest(d, n.modem.poll_timeout());
-            d = earliest(d, n.app.as_ref().and_then(|a| a.poll_timeout()));
+            d = earliest(d, n.host.poll_timeout());
         }
         d
     }
@@ -369,9 +568,11 @@ impl Sim {
 
     fn wire(&mut self, dir: Dir) -> &mut Wire {
         let n = &mut self.nodes[0];
-        match dir {
-            Dir::HostToModem => &mut n.down,
-            Dir::ModemToHost => &mut n.up,
+        match (self.attach, dir) {
+            (Attach::Modem, Dir::HostToModem) => &mut n.down,
+            (Attach::Modem, Dir::ModemToHost) => &mut n.up,
+            (Attach::Board, Dir::HostToModem) => &mut self.usart_down,
+            (Attach::Board, Dir::ModemToHost) => &mut self.usart_up,
         }
     }
 
@@ -400,14 +601,16 @@ impl Sim {
             self.dispatch(s.ev);
             self.flush();
         }
-        for i in 0..self.nodes.len() {
-            let n = &mut self.nodes[i];
+        let Sim { nodes, rng, .. } = self;
+        for n in nodes.iter_mut() {
             if n.modem.poll_timeout().is_some_and(|d| d <= now) {
                 n.modem.handle_timeout(now);
             }
-            if let Some(app) = n.app.as_mut() {
-                if app.poll_timeout().is_some_and(|d| d <= now) {
-                    app.handle_timeout(now);
+            if n.host.poll_timeout().is_some_and(|d| d <= now) {
+                match &mut n.host {
+                    Host::Outside => {}
+                    Host::Echo(e) => e.handle_timeout(now),
+                    Host::Board(b) => b.handle_timeout(now, rng),
                 }
             }
         }
@@ -422,11 +625,22 @@ impl Sim {
                     self.nodes[node].modem.handle_rx(now, &[byte]);
                 }
             }
-            Ev::ToHost { node, byte } => match self.nodes[node].app.as_mut() {
-                Some(app) => app.handle_rx(now, &[byte]),
-                None if self.plugged => self.host_rx.push_back((now, byte)),
-                None => {}
+            Ev::ToHost { node, byte } => match &mut self.nodes[node].host {
+                Host::Echo(app) => app.handle_rx(now, &[byte]),
+                Host::Board(b) => b.handle_rx(now, &[byte], &mut self.rng),
+                Host::Outside if self.plugged => self.host_rx.push_back((now, byte)),
+                Host::Outside => {}
             },
+            Ev::ToUsart { byte } => {
+                if let (true, Host::Board(b)) = (self.plugged, &mut self.nodes[0].host) {
+                    b.usart_rx(now, &[byte], &mut self.rng);
+                }
+            }
+            Ev::FromUsart { byte } => {
+                if self.plugged {
+                    self.host_rx.push_back((now, byte));
+                }
+            }
             Ev::Treq { node, asserted } => {
                 if node > 0 || self.plugged {
                     self.nodes[node].modem.set_treq(now, asserted);
@@ -450,7 +664,16 @@ impl Sim {
             while let Some(tx) = self.nodes[i].modem.poll_line() {
                 self.schedule(tx.start, Ev::TxStart(Box::new(tx)));
             }
-            while let Some(t) = self.nodes[i].app.as_mut().and_then(|a| a.poll_transmit()) {
+            while let Some(bytes) = match &mut self.nodes[i].host {
+                Host::Board(b) => b.poll_usart(),
+                _ => None,
+            } {
+                let arrivals = self.usart_up.write(now, &bytes, &mut self.rng);
+                for (at, byte) in arrivals {
+                    self.schedule(at, Ev::FromUsart { byte });
+                }
+            }
+            while let Some(t) = self.nodes[i].host.poll_transmit() {
                 match t {
                     Transmit::Bytes(bytes) => {
                         let arrivals = self.nodes[i].down.write(now, &bytes, &mut self.rng);
@@ -484,8 +707,11 @@ impl Sim {
         }
         self.seq += 1;
         let id = self.seq;
+        if self.nodes[tx.from].cut {
+            return;
+        }
         for to in 0..self.nodes.len() {
-            if to == tx.from {
+            if to == tx.from || self.nodes[to].cut {
                 continue;
             }
             let n = &self.nodes[to];

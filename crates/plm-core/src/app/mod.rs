@@ -11,13 +11,14 @@
 //! - [`line`]: how a frame travels over the power line in a DL frame.
 //! - [`usart`]: the USART stream decoder; [`requester`]: requests and
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
-//!   USART or a bare ST7580.
+//!   USART or a bare ST7580; [`discovery`]: finding the boards on a line.
 //!
 //! Decisions where the seed is silent are in docs/protocol-notes.md
 //! ("STEVAL-IHP007V1 application layer").
 
 pub mod concentrator;
 pub mod crc;
+pub mod discovery;
 pub mod error;
 pub mod frame;
 pub mod hid;
@@ -28,6 +29,7 @@ pub mod service;
 pub mod usart;
 
 pub use concentrator::{Carrier, Concentrator, Happening};
+pub use discovery::Discovery;
 pub use error::ErrorCode;
 pub use frame::{Address, AppFrame, FrameError, FrameType};
 pub use hid::{Ballast, Hid, LampState};

@@ -13,8 +13,10 @@
 //!   `max_attempts` times; then it fails, in words.
 //! - At most one request per board is in flight (the seed has no
 //!   sequence numbers: an answer is matched by board and kind), and at
-//!   most `max_in_flight` in all, so a sweep of a street keeps the channel
-//!   busy without flooding it.
+//!   most `max_in_flight` in all. The default is 1: the power line is
+//!   one half-duplex channel without carrier sense (the ST7580's PHY and
+//!   DL layers have none), so a second request sent while the first
+//!   board answers only collides with its answer.
 
 use super::frame::{Address, AppFrame};
 use super::message::{Expect, Message, MessageError};

@@ -1,0 +1,529 @@
+//! The street-light controller board (STEVAL-IHP007V1): an ST7580 whose
+//! host is the board's firmware, the application engine of UM 4.4.
+//!
+//! The firmware drives its modem with plm-core's host link engine over
+//! the simulated UART, exactly as the console drives a modem, and speaks
+//! plm-core's application layer: line frames in DL frames
+//! ([`plm_core::app::LineFrame`]), service commands, HID ballast commands
+//! forwarded to the board's [`HidBallast`] over the ballast's USART frames
+//! (Appendix A). It keeps what the seed gives a board: an RTC, 8 GPIO
+//! pins, three parameter groups, firmware and stack releases, the SNR of
+//! the last frame heard.
+//!
+//! A concentrator board (the one at the street's end, whose USART the
+//! console or `plm sim --board` talks to) also bridges (4.4, "the user
+//! program"): USART frames for other boards go out on the power line,
+//! line frames for it come back on the USART with the sender's address.
+
+use crate::ballast::{BallastConfig, HidBallast, Reply};
+use crate::rng::Rng;
+use plm_core::app::concentrator::USART_IDLE;
+use plm_core::app::hid::{self, Hid};
+use plm_core::app::service::{Discovered, Release, Service, PARAM_LEN, SNR_MAX};
+use plm_core::app::{
+    Address, AppFrame, Clock, ErrorCode, FrameType, LineFrame, Message, UsartDecoder, UsartElement,
+};
+use plm_core::link::host::{Event, HostConfig, HostEngine, Transmit};
+use plm_core::link::Dialect;
+use plm_core::st7580::{Command, DataRequest, TxParams};
+use plm_core::time::{earliest, Instant};
+use std::collections::VecDeque;
+
+/// The first board address of a simulated street: ST's OUI 00-80-E1, then
+/// the node number (the concentrator is node 0).
+pub const ADDRESS_BASE: u64 = 0x0080_E100_0000;
+/// Firmware release of the simulated boards' application.
+pub const FIRMWARE: Release = Release { major: 1, minor: 4 };
+/// Release of their ST7580 data link stack.
+pub const STACK: Release = Release { major: 2, minor: 0 };
+/// GPIO pins an input reads when nothing drives it: a photocell on IO0
+/// reporting night, the cabinet door switch on IO1 closed (model).
+pub const INPUT_LEVELS: u8 = 0b0000_0011;
+
+/// How long a board waits for its ballast before it reports HID error
+/// 12h, "HID board response timeout" (model).
+pub const HID_TIMEOUT: plm_core::time::Duration = 100 * plm_core::time::MS;
+
+/// The address of a street's node.
+pub fn street_address(node: usize) -> Address {
+    Address::from_u64(ADDRESS_BASE + node as u64)
+}
+
+/// How a board starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoardConfig {
+    /// Its address.
+    pub address: Address,
+    /// Its lamp (`None`: a concentrator in a cabinet, no ballast).
+    pub ballast: Option<BallastConfig>,
+    /// UART baud rate between the STM32 and its ST7580.
+    pub baud: u32,
+    /// Seconds the RTC is ahead of virtual midnight at power-on (drift).
+    pub clock_offset: u64,
+}
+
+/// A pending MIB frame: who asked, and whether it was a write.
+#[derive(Debug, Clone, Copy)]
+struct MibAsk {
+    from: Address,
+    index: u8,
+    write: bool,
+}
+
+/// A simulated controller board.
+#[derive(Debug, Clone)]
+pub struct Board {
+    address: Address,
+    engine: HostEngine,
+    params: TxParams,
+    /// Seconds of day at virtual time 0.
+    clock_offset: u64,
+    io_config: u8,
+    outputs: u8,
+    groups: [[u8; PARAM_LEN]; 3],
+    snr_threshold: u8,
+    last_snr: u8,
+    ballast: Option<HidBallast>,
+    /// Discovery: the session of the last request, the session this
+    /// board was acknowledged in, and when its reply is due (to whom).
+    discovery_session: Option<u8>,
+    discovery_acked: Option<u8>,
+    discovery_reply: Option<(Instant, Address)>,
+    mib_asks: VecDeque<MibAsk>,
+    /// Answers from the ballast on their way: when, to whom, what.
+    hid_answers: VecDeque<(Instant, Address, Message)>,
+    /// The USART to the outside host, for a concentrator.
+    usart: Option<UsartDecoder>,
+    /// When the last USART byte of an incomplete frame came.
+    usart_last: Option<Instant>,
+    usart_out: VecDeque<Vec<u8>>,
+    /// Frames handled (for tests and views).
+    pub handled: u64,
+}
+
+impl Board {
+    /// A board powered on at `now`.
+    pub fn new(now: Instant, config: BoardConfig) -> Self {
+        Board {
+            address: config.address,
+            engine: HostEngine::new(
+                Dialect::St7580,
+                HostConfig {
+                    baud: config.baud,
+                    ..HostConfig::default()
+                },
+            ),
+            params: TxParams::default(),
+            clock_offset: config.clock_offset,
+            io_config: 0,
+            outputs: 0,
+            groups: [[0; PARAM_LEN]; 3],
+            snr_threshold: 0,
+            last_snr: 0,
+            ballast: config.ballast.map(|b| HidBallast::new(now, b)),
+            discovery_session: None,
+            discovery_acked: None,
+            discovery_reply: None,
+            mib_asks: VecDeque::new(),
+            hid_answers: VecDeque::new(),
+            usart: None,
+            usart_last: None,
+            usart_out: VecDeque::new(),
+            handled: 0,
+        }
+    }
+
+    /// The same board with a USART to the outside host (a concentrator).
+    pub fn with_usart(mut self) -> Self {
+        self.usart = Some(UsartDecoder::new());
+        self
+    }
+
+    /// Its address.
+    pub fn address(&self) -> Address {
+        self.address
+    }
+
+    /// Its lamp.
+    pub fn ballast(&self) -> Option<&HidBallast> {
+        self.ballast.as_ref()
+    }
+
+    /// Its lamp, to fail or repair it on demand.
+    pub fn ballast_mut(&mut self) -> Option<&mut HidBallast> {
+        self.ballast.as_mut()
+    }
+
+    /// The RTC at `now`.
+    pub fn clock(&self, now: Instant) -> Clock {
+        Clock::from_seconds(self.clock_offset + now / 1_000_000)
+    }
+
+    /// GPIO pins configured as outputs (bit x = IOx).
+    pub fn io_config(&self) -> u8 {
+        self.io_config
+    }
+
+    /// Output pin levels.
+    pub fn outputs(&self) -> u8 {
+        self.outputs
+    }
+
+    /// Bytes from its modem.
+    pub fn handle_rx(&mut self, now: Instant, bytes: &[u8], rng: &mut Rng) {
+        self.engine.handle_rx(now, bytes);
+        self.pump(now, rng);
+    }
+
+    /// Bytes from the outside host on the USART (a concentrator).
+    pub fn usart_rx(&mut self, now: Instant, bytes: &[u8], rng: &mut Rng) {
+        let Some(d) = self.usart.as_mut() else { return };
+        d.push(bytes);
+        self.usart_last = d.is_partial().then_some(now);
+        self.pump(now, rng);
+    }
+
+    /// When [`Board::handle_timeout`] is due.
+    pub fn poll_timeout(&self) -> Option<Instant> {
+        let t = earliest(
+            self.engine.poll_timeout(),
+            self.discovery_reply.map(|r| r.0),
+        );
+        let t = earliest(t, self.hid_answers.front().map(|a| a.0));
+        earliest(t, self.usart_last.map(|t| t + USART_IDLE))
+    }
+
+    /// Runs what is due.
+    pub fn handle_timeout(&mut self, now: Instant, rng: &mut Rng) {
+        if self.engine.poll_timeout().is_some_and(|t| t <= now) {
+            self.engine.handle_timeout(now);
+        }
+        if self.usart_last.is_some_and(|t| t + USART_IDLE <= now) {
+            // The USART went quiet: a frame begun is given up.
+            self.usart_last = None;
+            if let Some(d) = self.usart.as_mut() {
+                d.idle();
+            }
+        }
+        while self.hid_answers.front().is_some_and(|a| a.0 <= now) {
+            let (_, to, m) = self.hid_answers.pop_front().expect("front exists");
+            self.answer(now, to, m);
+        }
+        if let Some((at, to)) = self.discovery_reply {
+            if at <= now {
+                self.discovery_reply = None;
+                let reply = Service::DiscoverReply(Discovered {
+                    firmware: FIRMWARE,
+                    stack: STACK,
+                    snr: self.last_snr,
+                });
+                self.send_line(now, to, &Message::Service(reply));
+            }
+        }
+        self.pump(now, rng);
+    }
+
+    /// The next bytes or T_REQ change for its modem.
+    pub fn poll_transmit(&mut self) -> Option<Transmit> {
+        self.engine.poll_transmit()
+    }
+
+    /// The next bytes for the outside host on the USART.
+    pub fn poll_usart(&mut self) -> Option<Vec<u8>> {
+        self.usart_out.pop_front()
+    }
+
+    fn pump(&mut self, now: Instant, rng: &mut Rng) {
+        while let Some(el) = self.usart.as_mut().and_then(|d| d.next()) {
+            if let UsartElement::Frame { frame, .. } = el {
+                self.on_usart_frame(now, frame, rng);
+            }
+        }
+        while let Some(ev) = self.engine.poll_event() {
+            let Event::Frame(f) = ev else { continue };
+            match Command::from_frame(&f) {
+                Ok(Command::DlDataIndication(ind)) => {
+                    let Some(line) = LineFrame::parse(&ind.payload) else {
+                        continue;
+                    };
+                    if !line.is_for(self.address) || line.source == self.address {
+                        continue;
+                    }
+                    let snr = if ind.info.snr == 0xFF {
+                        0
+                    } else {
+                        ind.info.snr as i8
+                    };
+                    self.last_snr = snr.clamp(0, SNR_MAX as i8) as u8;
+                    if self.last_snr < self.snr_threshold {
+                        continue; // below the SN_SET threshold: not acted on
+                    }
+                    self.on_line_frame(now, line, rng);
+                }
+                Ok(Command::MibReadConfirm { data }) => self.mib_answer(now, Some(data)),
+                Ok(Command::MibWriteConfirm) => self.mib_answer(now, None),
+                Ok(Command::MibReadError(_) | Command::MibWriteError(_)) => {
+                    if let Some(ask) = self.mib_asks.pop_front() {
+                        self.answer(now, ask.from, Message::Error(ErrorCode::SERVICE_CMD_ERROR));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// A frame from the outside host: for this board, or for the line.
+    fn on_usart_frame(&mut self, now: Instant, frame: AppFrame, rng: &mut Rng) {
+        if !frame.broadcast && frame.address == self.address {
+            let me = self.address;
+            if let Some(reply) = self.handle(now, me, false, &frame, rng) {
+                self.usart_send(reply.to(me));
+            }
+            return;
+        }
+        let line = LineFrame::from_app(&frame, self.address);
+        self.submit_line(now, &line);
+    }
+
+    /// A line frame for this board.
+    fn on_line_frame(&mut self, now: Instant, line: LineFrame, rng: &mut Rng) {
+        self.handled += 1;
+        if self.usart.is_some() {
+            // A concentrator hands what comes for it to its host (4.4).
+            self.usart_send(line.to_app());
+            return;
+        }
+        let frame = line.to_app();
+        if let Some(reply) = self.handle(now, line.source, line.broadcast, &frame, rng) {
+            if !line.broadcast {
+                self.send_line(now, line.source, &reply);
+            }
+        }
+    }
+
+    /// The application engine: what this board answers `frame` from
+    /// `from`; broadcasts are carried out and not answered.
+    fn handle(
+        &mut self,
+        now: Instant,
+        from: Address,
+        broadcast: bool,
+        frame: &AppFrame,
+        rng: &mut Rng,
+    ) -> Option<Message> {
+        let m = match Message::of(frame) {
+            Ok(m) => m,
+            Err(_) if frame.frame_type == FrameType::Service => {
+                return Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR))
+            }
+            Err(_) => return None,
+        };
+        match &m {
+            Message::Ping => Some(m.ack()),
+            Message::Service(s) => self.service(now, from, broadcast, s, rng),
+            Message::Hid(h) => {
+                self.hid(now, from, broadcast, h, &m);
+                None
+            }
+            Message::Ack {
+                frame_type: FrameType::Service,
+                echo: 0x0b,
+            } => {
+                self.discovery_acked = self.discovery_session;
+                None
+            }
+            Message::Programming { group, data } => Some(self.program(*group, data, &m)),
+            Message::Mib { index, data } => {
+                let cmd = if data.is_empty() {
+                    Command::MibReadRequest { index: *index }
+                } else {
+                    Command::MibWriteRequest {
+                        index: *index,
+                        data: data.clone(),
+                    }
+                };
+                self.mib_asks.push_back(MibAsk {
+                    from,
+                    index: *index,
+                    write: !data.is_empty(),
+                });
+                self.engine.submit(now, cmd.to_frame());
+                None
+            }
+            _ => None,
+        }
+    }
+
+    fn program(&mut self, group: u8, data: &[u8], m: &Message) -> Message {
+        match self.groups.get_mut(group as usize) {
+            Some(g) if data.len() == PARAM_LEN => {
+                g.copy_from_slice(data);
+                m.ack()
+            }
+            Some(_) => Message::Error(ErrorCode(0x08)),
+            None => Message::Error(ErrorCode::WRONG_PROG_GROUP),
+        }
+    }
+
+    fn service(
+        &mut self,
+        now: Instant,
+        from: Address,
+        broadcast: bool,
+        s: &Service,
+        rng: &mut Rng,
+    ) -> Option<Message> {
+        if s.validate().is_err() {
+            let code = match s {
+                Service::ClockSet(_) => ErrorCode::RTC_ERROR,
+                Service::ParamSet { group, .. } | Service::ParamGet { group } if *group > 2 => {
+                    ErrorCode::WRONG_PROG_GROUP
+                }
+                _ => ErrorCode::SERVICE_CMD_ERROR,
+            };
+            return Some(Message::Error(code));
+        }
+        let ack = Some(Message::Service(s.clone()).ack());
+        let reply = |s: Service| Some(Message::Service(s));
+        match s {
+            Service::SoftwareReset => {
+                self.discovery_reply = None;
+                None
+            }
+            Service::HardwareReset => {
+                self.io_config = 0;
+                self.outputs = 0;
+                self.discovery_reply = None;
+                None
+            }
+            Service::ParamSet { group, data } => {
+                self.groups[*group as usize].copy_from_slice(data);
+                ack
+            }
+            Service::ParamGet { group } => reply(Service::Params {
+                group: *group,
+                data: self.groups[*group as usize].to_vec(),
+            }),
+            Service::InputsGet => reply(Service::Inputs(self.inputs())),
+            Service::OutputsSet(v) => {
+                self.outputs = *v & self.io_config;
+                ack
+            }
+            Service::FwRelGet => reply(Service::FwRel {
+                firmware: FIRMWARE,
+                stack: STACK,
+            }),
+            Service::ClockSet(c) => {
+                let since_boot = now / 1_000_000;
+                self.clock_offset =
+                    (c.seconds_of_day() as u64 + 86_400 - since_boot % 86_400) % 86_400;
+                ack
+            }
+            Service::ClockGet => reply(Service::ClockNow(self.clock(now))),
+            Service::IoConfigSet(v) => {
+                self.io_config = *v;
+                self.outputs &= *v;
+                ack
+            }
+            Service::IoConfigGet => reply(Service::IoConfig(self.io_config)),
+            Service::Discover { session, window } => {
+                self.discovery_session = Some(*session);
+                if self.discovery_acked != Some(*session) {
+                    let delay = rng.below(*window as u64 * 1_000_000);
+                    self.discovery_reply = Some((now + delay, from));
+                }
+                None
+            }
+            Service::SnSet(v) => {
+                self.snr_threshold = *v;
+                ack
+            }
+            Service::SnGet => reply(Service::Sn(self.last_snr)),
+            _ if broadcast => None,
+            // Replies and commands this firmware does not implement (RFU
+            // comes with the update protocol).
+            _ => Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR)),
+        }
+    }
+
+    /// GPIO inputs: input pins read [`INPUT_LEVELS`], output pins their
+    /// own level.
+    fn inputs(&self) -> u8 {
+        (INPUT_LEVELS & !self.io_config) | (self.outputs & self.io_config)
+    }
+
+    /// A HID command goes to the ballast on its USART (Appendix A); its
+    /// answer goes back to `from` once the ballast gave it (nothing for a
+    /// broadcast).
+    fn hid(&mut self, now: Instant, from: Address, broadcast: bool, h: &Hid, m: &Message) {
+        if matches!(h, Hid::Reply { .. }) {
+            return;
+        }
+        let (at, answer) = match self.ballast.as_mut() {
+            // No ballast on this board: "HID packet delivery impossible".
+            None => (now, Message::Error(ErrorCode(0x13))),
+            Some(b) => match b.handle(now, &hid::ballast_frame(&h.payload())) {
+                None => (now + HID_TIMEOUT, Message::Error(ErrorCode::HID_TIMEOUT)),
+                Some(a) => (
+                    a.at,
+                    match a.reply {
+                        Reply::Frame(f) => match hid::ballast_payload(&f).and_then(Hid::parse) {
+                            Some(r @ Hid::Reply { .. }) => Message::Hid(r),
+                            _ => m.ack(),
+                        },
+                        r => Message::Error(r.error().unwrap_or(ErrorCode(0x10))),
+                    },
+                ),
+            },
+        };
+        if !broadcast {
+            self.hid_answers.push_back((at, from, answer));
+        }
+    }
+
+    fn mib_answer(&mut self, now: Instant, data: Option<Vec<u8>>) {
+        let Some(ask) = self.mib_asks.pop_front() else {
+            return;
+        };
+        let msg = match data {
+            Some(d) if !ask.write => Message::Mib {
+                index: ask.index,
+                data: d,
+            },
+            _ => Message::Mib {
+                index: ask.index,
+                data: vec![0],
+            }
+            .ack(),
+        };
+        self.answer(now, ask.from, msg);
+    }
+
+    /// Sends an answer back where the question came from.
+    fn answer(&mut self, now: Instant, to: Address, m: Message) {
+        if to == self.address {
+            self.usart_send(m.to(to));
+        } else {
+            self.send_line(now, to, &m);
+        }
+    }
+
+    fn send_line(&mut self, now: Instant, to: Address, m: &Message) {
+        let line = LineFrame::from_app(&m.to(to), self.address);
+        self.submit_line(now, &line);
+    }
+
+    fn submit_line(&mut self, now: Instant, line: &LineFrame) {
+        let cmd = Command::DlDataRequest(DataRequest {
+            params: self.params,
+            payload: line.emit(),
+        });
+        self.engine.submit(now, cmd.to_frame());
+    }
+
+    fn usart_send(&mut self, frame: AppFrame) {
+        if let Ok(bytes) = frame.emit() {
+            self.usart_out.push_back(bytes);
+        }
+    }
+}

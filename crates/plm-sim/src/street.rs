@@ -1,0 +1,174 @@
+//! A concentrator (plm-core's [`Concentrator`]) joined to a [`Sim`] in
+//! virtual time: what the console does with the page's timers and
+//! `plm board` with a serial port, done as fast as possible, over either
+//! way in ([`Attach`]). Tests and `cargo xtask bench` use it.
+
+use crate::board::street_address;
+use crate::sim::{Attach, Sim};
+use plm_core::app::{
+    Address, AppEvent, Concentrator, Discovery, Happening, Message, Request, RequestId,
+    RequesterConfig,
+};
+use plm_core::link::host::Transmit;
+use plm_core::st7580::TxParams;
+use plm_core::time::{earliest, Duration, Instant};
+use std::collections::BTreeMap;
+
+/// A concentrator driving a simulated street.
+#[derive(Debug, Clone)]
+pub struct StreetDriver {
+    /// The simulation.
+    pub sim: Sim,
+    /// The host's concentrator.
+    pub conc: Concentrator,
+    /// Every happening so far, with its time.
+    pub log: Vec<(Instant, Happening)>,
+}
+
+impl StreetDriver {
+    /// A concentrator for `sim`, of the kind its node 0 needs: over the
+    /// board's USART, or speaking the board protocol through the bare
+    /// modem from node 0's street address.
+    pub fn new(sim: Sim, config: RequesterConfig) -> Self {
+        let conc = match sim.attach() {
+            Attach::Board => Concentrator::usart(config),
+            Attach::Modem => {
+                Concentrator::modem(config, sim.baud(), street_address(0), TxParams::default())
+            }
+        };
+        StreetDriver {
+            sim,
+            conc,
+            log: Vec::new(),
+        }
+    }
+
+    /// Virtual time now.
+    pub fn now(&self) -> Instant {
+        self.sim.now()
+    }
+
+    /// Queues a request.
+    pub fn submit(&mut self, request: Request) -> RequestId {
+        let now = self.sim.now();
+        let id = self.conc.submit(now, request);
+        self.flush();
+        id
+    }
+
+    /// Sends a frame without waiting for anything.
+    pub fn send(&mut self, frame: plm_core::app::AppFrame) {
+        let now = self.sim.now();
+        self.conc.send(now, frame);
+        self.flush();
+    }
+
+    fn flush(&mut self) {
+        while let Some(t) = self.conc.poll_transmit() {
+            match t {
+                Transmit::Bytes(b) => self.sim.write(&b),
+                Transmit::TReq { asserted } => self.sim.set_treq(asserted),
+            }
+        }
+    }
+
+    /// Runs one step: to the next deadline of the world or the
+    /// concentrator, at most `until`. Returns the happenings of the step.
+    pub fn step(&mut self, until: Instant) -> Vec<Happening> {
+        let next = earliest(self.sim.next_deadline(), self.conc.poll_timeout())
+            .unwrap_or(until)
+            .clamp(self.sim.now(), until);
+        self.sim.advance_to(next);
+        let now = self.sim.now();
+        for (at, byte) in self.sim.host_read() {
+            self.conc.handle_rx(at, &[byte]);
+        }
+        if self.conc.poll_timeout().is_some_and(|t| t <= now) {
+            self.conc.handle_timeout(now);
+        }
+        self.flush();
+        let mut out = Vec::new();
+        while let Some(h) = self.conc.poll_happening() {
+            self.log.push((now, h.clone()));
+            out.push(h);
+        }
+        out
+    }
+
+    /// Runs until `done` holds for a happening or `limit` µs have passed;
+    /// returns whether `done` held.
+    pub fn run_until(&mut self, limit: Duration, mut done: impl FnMut(&Happening) -> bool) -> bool {
+        let until = self.sim.now() + limit;
+        while self.sim.now() < until {
+            if self.step(until).iter().any(&mut done) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Runs for `d` µs.
+    pub fn run_for(&mut self, d: Duration) {
+        self.run_until(d, |_| false);
+    }
+
+    /// Sends a request and waits for its fate (answer, failure, or sent).
+    pub fn request(&mut self, request: Request, limit: Duration) -> Option<AppEvent> {
+        let id = self.submit(request);
+        let mut fate = None;
+        self.run_until(limit, |h| match h {
+            Happening::App(
+                e @ (AppEvent::Answered { id: i, .. }
+                | AppEvent::Failed { id: i, .. }
+                | AppEvent::Sent { id: i }),
+            ) if *i == id => {
+                fate = Some(e.clone());
+                true
+            }
+            _ => false,
+        });
+        fate
+    }
+
+    /// The answer to a request to one board, or why there is none.
+    pub fn ask(
+        &mut self,
+        to: Address,
+        message: Message,
+        limit: Duration,
+    ) -> Result<Message, String> {
+        match self.request(Request::to(to, message), limit) {
+            Some(AppEvent::Answered { answer, .. }) => Ok(answer),
+            Some(AppEvent::Failed { reason, .. }) => Err(reason),
+            other => Err(format!("no answer within the time allowed ({other:?})")),
+        }
+    }
+
+    /// Discovers the boards on the line in rounds; returns what was found.
+    pub fn discover(
+        &mut self,
+        session: u8,
+        window: u8,
+        max_rounds: u8,
+    ) -> BTreeMap<Address, plm_core::app::Discovered> {
+        let (mut d, first) = Discovery::start(self.sim.now(), session, window, max_rounds);
+        self.submit(first);
+        while !d.is_done() {
+            let until = d.poll_timeout().unwrap_or(self.sim.now());
+            for h in self.step(until) {
+                if let Happening::App(AppEvent::Unsolicited {
+                    address, message, ..
+                }) = h
+                {
+                    if let Some(ack) = d.on_message(address, &message) {
+                        self.send(ack);
+                    }
+                }
+            }
+            if let Some(next) = d.handle_timeout(self.sim.now()) {
+                self.submit(next);
+            }
+        }
+        d.found().clone()
+    }
+}

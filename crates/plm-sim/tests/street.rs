@@ -1,0 +1,166 @@
+//! A street of simulated controller boards driven by plm-core's
+//! concentrator in virtual time, through both ways in: a concentrator
+//! board's USART and a bare ST7580 (DESIGN.md, connection profiles).
+
+use plm_core::app::hid::{self, Hid, LampState};
+use plm_core::app::service::{Clock, Service};
+use plm_core::app::{AppEvent, Ballast, Message, Request, RequesterConfig};
+use plm_core::time::{Duration, MS};
+use plm_sim::board::street_address;
+use plm_sim::{Attach, ByteFaults, Dir, LineConfig, Sim, SimConfig, StreetDriver};
+
+const S: Duration = 1_000 * MS;
+
+fn street(lamps: usize, via: Attach, seed: u64) -> StreetDriver {
+    let sim = Sim::new(SimConfig {
+        seed,
+        ..SimConfig::street(lamps, via)
+    });
+    let mut d = StreetDriver::new(sim, RequesterConfig::default());
+    d.run_for(2 * S);
+    d
+}
+
+fn all_parameters(d: &mut StreetDriver, node: usize) -> Result<Ballast, String> {
+    match d.ask(
+        street_address(node),
+        Message::Hid(Hid::Get(hid::ALL)),
+        30 * S,
+    )? {
+        Message::Hid(Hid::Reply { value, .. }) => {
+            Ballast::decode(&value).ok_or("short reply".into())
+        }
+        m => Err(format!("{m:?}")),
+    }
+}
+
+fn journey(via: Attach) {
+    let lamps = 50;
+    let mut d = street(lamps, via, 7);
+
+    // Discover every board.
+    let found = d.discover(1, plm_core::app::Discovery::window_for(lamps), 12);
+    let missing: Vec<usize> = (1..=lamps)
+        .filter(|n| !found.contains_key(&street_address(*n)))
+        .collect();
+    assert!(missing.is_empty(), "{via:?}: lamps not found: {missing:?}");
+    assert_eq!(
+        found.len(),
+        lamps,
+        "{via:?}: nothing but the street's lamps"
+    );
+
+    // Read every lamp: all lit.
+    for node in 1..=lamps {
+        let b = all_parameters(&mut d, node).unwrap_or_else(|e| panic!("{via:?} node {node}: {e}"));
+        assert_eq!(b.state(), LampState::Run, "{via:?} node {node}");
+        assert!(b.lamp_power > 0);
+    }
+
+    // Dim every lamp by broadcast; the power follows.
+    let full = all_parameters(&mut d, 3).unwrap().lamp_power;
+    let sent = d.request(Request::all(Message::Hid(Hid::Dimming(30))), 10 * S);
+    assert!(matches!(sent, Some(AppEvent::Sent { .. })), "{sent:?}");
+    d.run_for(5 * S);
+    for node in [1, 17, lamps] {
+        let b = all_parameters(&mut d, node).unwrap();
+        assert!(
+            b.lamp_power < full,
+            "{via:?} node {node}: {} W dimmed vs {full} W",
+            b.lamp_power
+        );
+        assert_eq!(d.sim.board(node).unwrap().ballast().unwrap().dimming(), 30);
+    }
+
+    // Set every clock by broadcast.
+    let noon = Clock {
+        hours: 12,
+        minutes: 0,
+        seconds: 0,
+    };
+    d.request(
+        Request::all(Message::Service(Service::ClockSet(noon))),
+        10 * S,
+    );
+    d.run_for(2 * S);
+    for node in [2, lamps] {
+        match d.ask(
+            street_address(node),
+            Message::Service(Service::ClockGet),
+            30 * S,
+        ) {
+            Ok(Message::Service(Service::ClockNow(c))) => {
+                let drift = c.seconds_of_day().abs_diff(noon.seconds_of_day());
+                assert!(drift <= 5, "{via:?} node {node}: {c} after setting {noon}");
+            }
+            other => panic!("{via:?} node {node}: {other:?}"),
+        }
+    }
+
+    // A lamp fails: its state says so.
+    let now = d.now();
+    d.sim
+        .with_board(11, |b, _| b.ballast_mut().unwrap().fail(now));
+    let b = all_parameters(&mut d, 11).unwrap();
+    assert_eq!(b.state(), LampState::Failure, "{via:?}");
+    assert_eq!(b.lamp_power, 0);
+
+    // A board loses its supply: the request fails in words.
+    d.sim.set_cut(23, true);
+    let e = all_parameters(&mut d, 23).unwrap_err();
+    assert!(e.contains("did not answer"), "{via:?}: {e}");
+}
+
+#[test]
+fn a_street_of_50_through_the_concentrator_board() {
+    journey(Attach::Board);
+}
+
+#[test]
+fn a_street_of_50_through_a_bare_modem() {
+    journey(Attach::Modem);
+}
+
+/// UART faults on the concentrator's cable and losses on the line: no
+/// dimming the concentrator saw acknowledged is missing on its lamp.
+#[test]
+fn faults_lose_no_acknowledged_command() {
+    for via in [Attach::Board, Attach::Modem] {
+        let mut d = street(8, via, 11);
+        d.sim.set_line(LineConfig {
+            loss: 0.05,
+            ..d.sim.line().clone()
+        });
+        let faults = ByteFaults {
+            drop: 0.002,
+            corrupt: 0.002,
+            ..ByteFaults::default()
+        };
+        d.sim.set_byte_faults(Dir::HostToModem, faults);
+        d.sim.set_byte_faults(Dir::ModemToHost, faults);
+        let (mut acked, mut failed) = (0, 0);
+        for i in 0..60u8 {
+            let node = 1 + i as usize % 8;
+            let level = 10 + i;
+            match d.request(
+                Request::to(street_address(node), Message::Hid(Hid::Dimming(level))),
+                60 * S,
+            ) {
+                Some(AppEvent::Answered {
+                    answer: Message::Ack { .. },
+                    ..
+                }) => {
+                    acked += 1;
+                    let dim = d.sim.board(node).unwrap().ballast().unwrap().dimming();
+                    assert_eq!(
+                        dim, level,
+                        "{via:?}: an acknowledged dimming is on the lamp"
+                    );
+                }
+                Some(AppEvent::Failed { .. }) => failed += 1,
+                other => panic!("{via:?}: {other:?}"),
+            }
+        }
+        assert!(acked > 40, "{via:?}: {acked} acknowledged, {failed} failed");
+    }
+}
