@@ -4,6 +4,8 @@
 //!   WebSerial).
 //! - [`session`]: plm-core's host link engine over a transport, requests
 //!   matched with their answers.
+//! - [`street`]: plm-core's concentrator over a transport, and the fleet
+//!   of lamps it learns about.
 //! - [`traffic`]: the inspector's bounded, filterable, exportable log.
 //! - [`mibform`]: MIB forms read from plm-core's declarative description.
 //! - [`app`], [`stores`], [`views`]: the Leptos application.
@@ -11,6 +13,7 @@
 
 pub mod mibform;
 pub mod session;
+pub mod street;
 pub mod traffic;
 pub mod transport;
 

@@ -40,6 +40,37 @@ pub const DUPLICATE_GRACE: Duration = 200 * MS;
 /// ACK latencies kept for the percentiles (the most recent ones).
 pub const ACK_SAMPLES: usize = 1_000;
 
+/// Maps the page's clock onto a transport's clock: the transport's time
+/// follows the page's, but never more than [`MAX_CATCH_UP`] at once.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Pacer {
+    /// Page time (µs) at which the transport's clock read 0.
+    origin: Option<f64>,
+    /// The page's clock on the transport's clock at the last call.
+    page_now: Instant,
+}
+
+impl Pacer {
+    /// Where the transport's time, now at `start`, should run to when the
+    /// page's clock reads `page_us`.
+    pub fn target(&mut self, page_us: f64, start: Instant) -> Instant {
+        let origin = *self.origin.get_or_insert(page_us - start as f64);
+        let target = (page_us - origin).max(0.0) as Instant;
+        self.page_now = target;
+        if target > start + MAX_CATCH_UP {
+            self.origin = Some(page_us - (start + MAX_CATCH_UP) as f64);
+            return start + MAX_CATCH_UP;
+        }
+        target
+    }
+
+    /// The page's clock on the transport's clock at the last call (before
+    /// any catch-up limit).
+    pub fn page_now(&self) -> Instant {
+        self.page_now
+    }
+}
+
 /// What became of a request.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Outcome {
@@ -215,8 +246,8 @@ pub struct Session {
     active: Option<Active>,
     /// A request code whose second answer is expected until the instant.
     duplicate_of: Option<(u8, Instant)>,
-    /// Page time (µs) at which the transport's clock read 0.
-    origin: Option<f64>,
+    /// The page's clock mapped onto the transport's.
+    pacer: Pacer,
     /// Added to the transport's clock in every [`Note`]: the times of one
     /// connection carry on from where the last one stopped, so the log
     /// never runs backwards when the transport changes (the simulator's
@@ -239,7 +270,7 @@ impl Session {
             queue: VecDeque::new(),
             active: None,
             duplicate_of: None,
-            origin: None,
+            pacer: Pacer::default(),
             log_offset: 0,
             page_now: 0,
             ack_times: AckTimes::default(),
@@ -282,7 +313,7 @@ impl Session {
         self.host = host_engine(baud);
         self.decoder = Decoder::new(Dialect::St7580, Source::Any);
         self.transport = transport;
-        self.origin = None;
+        self.pacer = Pacer::default();
         self.duplicate_of = None;
         self.ack_times = AckTimes::default();
         self.out.notes.push(Note::TReq(false));
@@ -346,13 +377,8 @@ impl Session {
             }
         }
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
-            let origin = *self.origin.get_or_insert(page_us - start as f64);
-            let mut target = (page_us - origin).max(0.0) as Instant;
-            self.page_now = target;
-            if target > start + MAX_CATCH_UP {
-                target = start + MAX_CATCH_UP;
-                self.origin = Some(page_us - target as f64);
-            }
+            let target = self.pacer.target(page_us, start);
+            self.page_now = self.pacer.page_now();
             self.run_until(start, target);
         }
         self.take()

@@ -80,4 +80,20 @@ pub trait Simulator {
     fn plugged(&self) -> bool;
     /// Line events since the last call, oldest first.
     fn line_events(&mut self) -> Vec<LineEvent>;
+    /// Does something to the lamp of street node `node` (1..): faults on
+    /// demand for demos and tests.
+    fn lamp(&mut self, node: usize, action: LampAction);
+}
+
+/// What the Simulator view can do to one lamp of a simulated street.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LampAction {
+    /// The lamp breaks (FAILURE until repaired).
+    Fail,
+    /// A technician fits a new lamp.
+    Repair,
+    /// The board's supply is cut: it neither hears nor answers.
+    Cut,
+    /// Its supply is back.
+    Join,
 }

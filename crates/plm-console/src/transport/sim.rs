@@ -2,9 +2,9 @@
 //! echoing peers) running in the page. Its clock is the simulation's
 //! virtual time, which the session moves on in step with the page's clock.
 
-use super::{LinkState, Simulator, Transport};
+use super::{LampAction, LinkState, Simulator, Transport};
 use plm_core::time::Instant;
-use plm_sim::{ByteFaults, Dir, Fault, LineConfig, LineEvent, Sim, SimConfig};
+use plm_sim::{Attach, ByteFaults, Dir, Fault, LineConfig, LineEvent, Sim, SimConfig};
 
 /// A simulated modem on node 0 of a simulated power line.
 #[derive(Debug, Clone)]
@@ -25,6 +25,18 @@ impl SimTransport {
             }),
         }
     }
+
+    /// A street of `lamps` street-light boards behind a concentrator
+    /// board's USART, or behind a bare modem (`via`).
+    pub fn street(lamps: usize, via: Attach, baud: u32, seed: u64) -> Self {
+        SimTransport {
+            sim: Sim::new(SimConfig {
+                seed,
+                baud,
+                ..SimConfig::street(lamps, via)
+            }),
+        }
+    }
 }
 
 impl Transport for SimTransport {
@@ -33,6 +45,13 @@ impl Transport for SimTransport {
     }
 
     fn port(&self) -> String {
+        if self.sim.board(1).is_some() {
+            let lamps = self.sim.nodes() - 1;
+            return match self.sim.attach() {
+                Attach::Board => format!("concentrator board (simulated, {lamps} lamps)"),
+                Attach::Modem => format!("ST7580 concentrator (simulated, {lamps} lamps)"),
+            };
+        }
         match self.sim.nodes() {
             1 => "ST7580 (simulated, alone)".to_string(),
             2 => "ST7580 (simulated, 1 echoing peer)".to_string(),
@@ -111,5 +130,25 @@ impl Simulator for SimTransport {
 
     fn line_events(&mut self) -> Vec<LineEvent> {
         std::iter::from_fn(|| self.sim.poll_line_event()).collect()
+    }
+
+    fn lamp(&mut self, node: usize, action: LampAction) {
+        let cut = match action {
+            LampAction::Cut => Some(true),
+            LampAction::Join => Some(false),
+            _ => None,
+        };
+        if let Some(cut) = cut {
+            self.sim.set_cut(node, cut);
+            return;
+        }
+        self.sim.with_board(node, |b, now| {
+            if let Some(ballast) = b.ballast_mut() {
+                match action {
+                    LampAction::Fail => ballast.fail(now),
+                    _ => ballast.repair(now),
+                }
+            }
+        });
     }
 }

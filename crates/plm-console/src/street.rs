@@ -1,0 +1,627 @@
+//! The street session: plm-core's [`Concentrator`] driven over a
+//! transport with the page's timers, and the fleet of lamps it learns
+//! about (discovery, a background sweep, dimming, clocks), with alerts
+//! when a lamp fails or stops answering.
+//!
+//! Like [`crate::session`], it has no browser in it: time comes in as an
+//! argument, so its tests run natively against a simulated street.
+
+use crate::session::Pacer;
+use crate::transport::{LinkState, Transport};
+use plm_core::app::hid::{self, Hid, LampState};
+use plm_core::app::service::{Clock, Discovered, Service};
+use plm_core::app::{
+    Address, AppEvent, Ballast, Concentrator, Discovery, Happening, Message, Request, RequestId,
+    RequesterConfig,
+};
+use plm_core::link::host::Transmit;
+use plm_core::time::{Duration, Instant, MS};
+use std::collections::{BTreeMap, HashMap, VecDeque};
+
+/// Samples of a lamp's history kept for its plots.
+pub const HISTORY: usize = 240;
+/// Pause between two sweeps of the street.
+pub const SWEEP_PAUSE: Duration = 5_000 * MS;
+
+/// One reading of a lamp, for its history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// When, on the session's clock.
+    pub at: Instant,
+    /// Lamp power, W.
+    pub power: u16,
+    /// Board temperature, °C.
+    pub temperature: i16,
+    /// SNR, dB, when known.
+    pub snr: Option<i8>,
+}
+
+/// What the console knows of one lamp.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Lamp {
+    /// Its board's address.
+    pub address: Address,
+    /// What discovery said of it.
+    pub discovered: Option<Discovered>,
+    /// Its ballast as last read.
+    pub ballast: Option<Ballast>,
+    /// Dimming last set and acknowledged, %.
+    pub dimming: Option<u8>,
+    /// Signal quality, dB: the SNR of its last frame (bare modem), or
+    /// what the board reports.
+    pub snr: Option<i8>,
+    /// Its clock as last read.
+    pub clock: Option<Clock>,
+    /// When it last answered.
+    pub last_seen: Option<Instant>,
+    /// Why it does not answer, if it stopped.
+    pub unreachable: Option<String>,
+    /// Recent readings, oldest first.
+    pub history: VecDeque<Sample>,
+}
+
+impl Lamp {
+    /// Its lamp state, if read.
+    pub fn state(&self) -> Option<LampState> {
+        self.ballast.map(|b| b.state())
+    }
+
+    /// Whether it needs a technician's eye: failed or unreachable.
+    pub fn in_trouble(&self) -> bool {
+        self.unreachable.is_some() || self.state() == Some(LampState::Failure)
+    }
+}
+
+/// Something a technician must see.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Alert {
+    /// When.
+    pub at: Instant,
+    /// Which lamp.
+    pub address: Address,
+    /// What, in words.
+    pub what: String,
+}
+
+/// Progress of the background sweep.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Sweep {
+    /// Whether the sweep runs.
+    pub on: bool,
+    /// Lamps read in this round.
+    pub done: usize,
+    /// Lamps in this round.
+    pub total: usize,
+    /// Completed rounds.
+    pub rounds: u64,
+}
+
+/// Called once with the answer to a request made from a view.
+pub type StreetReply = Box<dyn FnOnce(Result<Message, String>)>;
+
+enum Purpose {
+    /// Read every parameter; `true` when the sweep asked.
+    Read(Address, bool),
+    Snr(Address),
+    Dim(Address, u8),
+    View(StreetReply),
+}
+
+/// What a tick produced.
+#[derive(Default)]
+pub struct StreetTick {
+    /// The fleet changed.
+    pub changed: bool,
+    /// New alerts.
+    pub alerts: Vec<Alert>,
+    /// Replies for the views, with their outcomes.
+    pub replies: Vec<(StreetReply, Result<Message, String>)>,
+    /// Frames on the wire (USART elements, or the modem's link), as
+    /// `plm decode` names them, with their times.
+    pub traffic: Vec<(Instant, serde_json::Value)>,
+}
+
+/// The street session.
+pub struct StreetSession {
+    transport: Option<Box<dyn Transport>>,
+    conc: Concentrator,
+    pacer: Pacer,
+    discovery: Option<Discovery>,
+    session_no: u8,
+    sweep: Sweep,
+    sweep_queue: VecDeque<Address>,
+    next_sweep: Option<Instant>,
+    fleet: BTreeMap<Address, Lamp>,
+    purposes: HashMap<RequestId, Purpose>,
+    out: StreetTick,
+}
+
+impl StreetSession {
+    /// A session over `transport` with `conc` (a board USART or a bare
+    /// modem concentrator, as the connection profile says).
+    pub fn new(transport: Box<dyn Transport>, conc: Concentrator) -> Self {
+        StreetSession {
+            transport: Some(transport),
+            conc,
+            pacer: Pacer::default(),
+            discovery: None,
+            session_no: 0,
+            sweep: Sweep::default(),
+            sweep_queue: VecDeque::new(),
+            next_sweep: None,
+            fleet: BTreeMap::new(),
+            purposes: HashMap::new(),
+            out: StreetTick::default(),
+        }
+    }
+
+    /// A session through a concentrator board's USART.
+    pub fn via_board(transport: Box<dyn Transport>) -> Self {
+        Self::new(transport, Concentrator::usart(RequesterConfig::default()))
+    }
+
+    /// The transport.
+    pub fn transport_mut(&mut self) -> Option<&mut (dyn Transport + 'static)> {
+        self.transport.as_deref_mut()
+    }
+
+    /// Whether bytes flow.
+    pub fn state(&self) -> LinkState {
+        self.transport
+            .as_ref()
+            .map_or(LinkState::Disconnected("not connected".into()), |t| {
+                t.state()
+            })
+    }
+
+    /// The transport's clock.
+    pub fn now(&self) -> Instant {
+        self.transport.as_ref().map_or(0, |t| t.now())
+    }
+
+    /// The lamps known so far.
+    pub fn fleet(&self) -> &BTreeMap<Address, Lamp> {
+        &self.fleet
+    }
+
+    /// The sweep's progress.
+    pub fn sweep(&self) -> Sweep {
+        self.sweep
+    }
+
+    /// Whether a discovery is running, and its round.
+    pub fn discovering(&self) -> Option<u8> {
+        self.discovery.as_ref().map(|d| d.round())
+    }
+
+    /// Requests not yet answered.
+    pub fn pending(&self) -> usize {
+        self.conc.requester().pending()
+    }
+
+    /// Starts a discovery (a new session: every board answers again).
+    pub fn discover(&mut self) {
+        let now = self.now();
+        self.session_no = self.session_no.wrapping_add(1);
+        let expected = self.fleet.len().max(12);
+        let (d, first) = Discovery::start(now, self.session_no, Discovery::window_for(expected), 8);
+        self.discovery = Some(d);
+        self.conc.submit(now, first);
+        self.flush();
+    }
+
+    /// Turns the background sweep on or off.
+    pub fn set_sweep(&mut self, on: bool) {
+        self.sweep.on = on;
+        if on && self.sweep_queue.is_empty() {
+            self.next_sweep = Some(self.now());
+        }
+        if !on {
+            self.sweep_queue.clear();
+            self.next_sweep = None;
+        }
+        self.out.changed = true;
+    }
+
+    /// Reads every parameter of one lamp now.
+    pub fn read(&mut self, address: Address) {
+        self.submit(
+            Request::to(address, Message::Hid(Hid::Get(hid::ALL))),
+            Purpose::Read(address, false),
+        );
+    }
+
+    /// Dims one lamp, or every lamp with `None` (broadcast). Refused
+    /// before anything is sent when the value is not 0-100.
+    pub fn dim(&mut self, target: Option<Address>, level: u8) -> Result<(), String> {
+        let m = Message::Hid(Hid::Dimming(level));
+        m.validate()?;
+        match target {
+            Some(a) => self.submit(Request::to(a, m), Purpose::Dim(a, level)),
+            None => {
+                self.submit(Request::all(m), Purpose::View(Box::new(|_| {})));
+                for lamp in self.fleet.values_mut() {
+                    lamp.dimming = Some(level);
+                }
+                // Read the street again soon to see the power follow.
+                self.next_sweep = Some(self.now() + 2_000 * MS);
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends any request from a view; `reply` gets the answer. Refused
+    /// before anything is sent when the board would refuse it.
+    pub fn request(&mut self, request: Request, reply: StreetReply) -> Result<(), String> {
+        request.message.validate()?;
+        self.submit(request, Purpose::View(reply));
+        Ok(())
+    }
+
+    fn submit(&mut self, request: Request, purpose: Purpose) {
+        if let LinkState::Disconnected(why) = self.state() {
+            if let Purpose::View(r) = purpose {
+                self.out.replies.push((r, Err(why)));
+            }
+            return;
+        }
+        let now = self.now();
+        let id = self.conc.submit(now, request);
+        self.purposes.insert(id, purpose);
+        self.flush();
+    }
+
+    /// What happened since the last call, without letting time pass.
+    pub fn take(&mut self) -> StreetTick {
+        std::mem::take(&mut self.out)
+    }
+
+    /// Lets the transport's time catch up with the page's clock.
+    pub fn tick(&mut self, page_us: f64) -> StreetTick {
+        if let LinkState::Disconnected(why) = self.state() {
+            if self.conc.requester().pending() > 0 {
+                self.conc.abort_all(&why);
+                self.handle_happenings();
+            }
+        }
+        if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
+            let target = self.pacer.target(page_us, start);
+            self.run_until(start, target);
+        }
+        self.take()
+    }
+
+    /// Runs the street as fast as possible up to `target` (tests).
+    pub fn run_until(&mut self, start: Instant, target: Instant) {
+        let mut t = start;
+        while t < target {
+            let mut next = (t + crate::session::SLICE).min(target);
+            for d in [
+                self.conc.poll_timeout(),
+                self.discovery.as_ref().and_then(|d| d.poll_timeout()),
+                self.next_sweep,
+            ] {
+                if let Some(d) = d.filter(|d| *d > t && *d < next) {
+                    next = d;
+                }
+            }
+            let Some(transport) = self.transport.as_mut() else {
+                return;
+            };
+            for (at, byte) in transport.poll(next) {
+                self.conc.handle_rx(at, &[byte]);
+            }
+            if self.conc.poll_timeout().is_some_and(|d| d <= next) {
+                self.conc.handle_timeout(next);
+            }
+            self.handle_happenings();
+            self.run_discovery(next);
+            self.run_sweep(next);
+            self.flush();
+            t = next;
+        }
+    }
+
+    fn flush(&mut self) {
+        let Some(t) = self.transport.as_mut() else {
+            return;
+        };
+        while let Some(tx) = self.conc.poll_transmit() {
+            match tx {
+                Transmit::Bytes(b) => t.write(&b),
+                Transmit::TReq { asserted } => t.set_treq(asserted),
+            }
+        }
+    }
+
+    fn run_discovery(&mut self, now: Instant) {
+        let Some(d) = self.discovery.as_mut() else {
+            return;
+        };
+        if let Some(next) = d.handle_timeout(now) {
+            self.conc.submit(now, next);
+        }
+        if d.is_done() {
+            self.discovery = None;
+            self.out.changed = true;
+            // A street just found is read at once.
+            self.next_sweep = Some(now);
+            self.sweep.on = true;
+        }
+    }
+
+    fn run_sweep(&mut self, now: Instant) {
+        if !self.sweep.on || self.discovery.is_some() {
+            return;
+        }
+        if self.next_sweep.is_some_and(|t| t <= now) {
+            self.next_sweep = None;
+            self.sweep_queue = self.fleet.keys().copied().collect();
+            self.sweep.total = self.sweep_queue.len();
+            self.sweep.done = 0;
+            self.out.changed = true;
+        }
+        // One lamp at a time: the requester paces the line.
+        if self.conc.requester().pending() == 0 {
+            if let Some(a) = self.sweep_queue.pop_front() {
+                let all = Message::Hid(Hid::Get(hid::ALL));
+                self.submit(Request::to(a, all), Purpose::Read(a, true));
+                self.submit(
+                    Request::to(a, Message::Service(Service::SnGet)),
+                    Purpose::Snr(a),
+                );
+            } else if self.next_sweep.is_none() && self.sweep.total > 0 {
+                self.sweep.rounds += 1;
+                self.sweep.total = 0;
+                self.next_sweep = Some(now + SWEEP_PAUSE);
+                self.out.changed = true;
+            }
+        }
+    }
+
+    fn handle_happenings(&mut self) {
+        let now = self.now();
+        while let Some(h) = self.conc.poll_happening() {
+            match h {
+                Happening::App(e) => self.on_app(now, e),
+                Happening::Heard { address, snr } => {
+                    if let Some(l) = self.fleet.get_mut(&address) {
+                        l.snr = snr.or(l.snr);
+                    }
+                }
+                Happening::Usart { element, .. } => {
+                    let d = plm_core::decode_app::decode_element(&element);
+                    self.out.traffic.push((now, d.to_json()));
+                }
+                Happening::Link(_) => {}
+            }
+        }
+    }
+
+    fn lamp(&mut self, a: Address) -> &mut Lamp {
+        self.fleet.entry(a).or_insert_with(|| Lamp {
+            address: a,
+            ..Lamp::default()
+        })
+    }
+
+    fn on_app(&mut self, now: Instant, e: AppEvent) {
+        match e {
+            AppEvent::Unsolicited {
+                address, message, ..
+            } => {
+                if let Some(d) = self.discovery.as_mut() {
+                    if let Some(ack) = d.on_message(address, &message) {
+                        self.conc.send(now, ack);
+                        if let Message::Service(Service::DiscoverReply(r)) = message {
+                            let lamp = self.lamp(address);
+                            lamp.discovered = Some(r);
+                            lamp.snr = lamp.snr.or(Some(r.snr as i8));
+                            lamp.last_seen = Some(now);
+                            self.out.changed = true;
+                        }
+                    }
+                }
+            }
+            AppEvent::Answered {
+                id,
+                address,
+                answer,
+                ..
+            } => {
+                let purpose = self.purposes.remove(&id);
+                self.answered(now, address, &answer);
+                if let Some(p) = purpose {
+                    self.fulfil(now, p, Ok(answer));
+                }
+            }
+            AppEvent::Failed {
+                id,
+                address,
+                reason,
+            } => {
+                if let Some(p) = self.purposes.remove(&id) {
+                    let unicast = !matches!(p, Purpose::View(_)) || address != Address::BROADCAST;
+                    if unicast && self.fleet.contains_key(&address) {
+                        self.unreachable(now, address, &reason);
+                    }
+                    self.fulfil(now, p, Err(reason));
+                }
+            }
+            AppEvent::Sent { id } => {
+                if let Some(p) = self.purposes.remove(&id) {
+                    self.fulfil(now, p, Ok(Message::Ping));
+                }
+            }
+            AppEvent::Retry { .. } | AppEvent::Malformed { .. } => {}
+        }
+    }
+
+    /// Any answer shows the lamp is there.
+    fn answered(&mut self, now: Instant, address: Address, _answer: &Message) {
+        let lamp = self.lamp(address);
+        lamp.last_seen = Some(now);
+        if lamp.unreachable.take().is_some() {
+            self.out.alerts.push(Alert {
+                at: now,
+                address,
+                what: "answers again".into(),
+            });
+        }
+        self.out.changed = true;
+    }
+
+    fn unreachable(&mut self, now: Instant, address: Address, reason: &str) {
+        let lamp = self.lamp(address);
+        if lamp.unreachable.is_none() {
+            lamp.unreachable = Some(reason.to_string());
+            self.out.alerts.push(Alert {
+                at: now,
+                address,
+                what: format!("stopped answering: {reason}"),
+            });
+        }
+        self.out.changed = true;
+    }
+
+    fn fulfil(&mut self, now: Instant, p: Purpose, r: Result<Message, String>) {
+        match (p, r) {
+            (Purpose::Read(a, sweep), Ok(Message::Hid(Hid::Reply { value, .. }))) => {
+                let Some(b) = Ballast::decode(&value) else {
+                    return;
+                };
+                let lamp = self.lamp(a);
+                let was = lamp.state();
+                lamp.ballast = Some(b);
+                let snr = lamp.snr;
+                lamp.history.push_back(Sample {
+                    at: now,
+                    power: b.lamp_power,
+                    temperature: b.temperature,
+                    snr,
+                });
+                if lamp.history.len() > HISTORY {
+                    lamp.history.pop_front();
+                }
+                if b.state() == LampState::Failure && was != Some(LampState::Failure) {
+                    self.out.alerts.push(Alert {
+                        at: now,
+                        address: a,
+                        what: format!(
+                            "lamp failed (was {} before the failure, lamp voltage {} V)",
+                            LampState::from_word(b.last_failure.status),
+                            b.last_failure.lamp_voltage
+                        ),
+                    });
+                }
+                self.sweep.done += sweep as usize;
+            }
+            (Purpose::Read(_, sweep), _) => self.sweep.done += sweep as usize,
+            (Purpose::Snr(a), Ok(Message::Service(Service::Sn(v)))) => {
+                if !matches!(self.conc.carrier(), plm_core::app::Carrier::Modem { .. }) {
+                    self.lamp(a).snr = Some(v as i8);
+                }
+            }
+            (Purpose::Dim(a, level), Ok(Message::Ack { .. })) => {
+                self.lamp(a).dimming = Some(level);
+                // Read it again to see its power follow.
+                self.read(a);
+            }
+            (Purpose::View(reply), r) => self.out.replies.push((reply, r)),
+            _ => {}
+        }
+        self.out.changed = true;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transport::sim::SimTransport;
+    use crate::transport::LampAction;
+    use plm_core::st7580::TxParams;
+    use plm_sim::board::street_address;
+    use plm_sim::Attach;
+
+    const S: Duration = 1_000 * MS;
+
+    fn session(via: Attach) -> StreetSession {
+        let t = Box::new(SimTransport::street(12, via, 57_600, 3));
+        let conc = match via {
+            Attach::Board => Concentrator::usart(RequesterConfig::default()),
+            Attach::Modem => Concentrator::modem(
+                RequesterConfig::default(),
+                57_600,
+                street_address(0),
+                TxParams::default(),
+            ),
+        };
+        StreetSession::new(t, conc)
+    }
+
+    fn run(s: &mut StreetSession, d: Duration) -> Vec<Alert> {
+        let start = s.now();
+        s.run_until(start, start + d);
+        s.take().alerts
+    }
+
+    /// Discovery, the sweep reading every lamp, dimming one and all, a
+    /// failed lamp and an unreachable one raised as alerts: through the
+    /// board's USART and through a bare modem.
+    #[test]
+    fn a_street_is_found_read_dimmed_and_watched() {
+        for via in [Attach::Board, Attach::Modem] {
+            let mut s = session(via);
+            s.discover();
+            run(&mut s, 60 * S);
+            assert_eq!(s.fleet().len(), 12, "{via:?}: every lamp found");
+            assert!(s.sweep().on, "a street just found is swept");
+            run(&mut s, 30 * S);
+            for lamp in s.fleet().values() {
+                assert_eq!(
+                    lamp.state(),
+                    Some(LampState::Run),
+                    "{via:?} {}",
+                    lamp.address
+                );
+                assert!(lamp.snr.is_some(), "{via:?} {}: SNR known", lamp.address);
+            }
+            let a3 = street_address(3);
+            let full = s.fleet()[&a3].ballast.unwrap().lamp_power;
+            s.dim(Some(a3), 20).unwrap();
+            run(&mut s, 10 * S);
+            let dimmed = s.fleet()[&a3].ballast.unwrap().lamp_power;
+            assert!(
+                dimmed < full,
+                "{via:?}: {dimmed} W after dimming, {full} W before"
+            );
+            assert_eq!(s.fleet()[&a3].dimming, Some(20));
+
+            assert!(s.dim(None, 101).is_err(), "refused before anything is sent");
+            s.dim(None, 60).unwrap();
+            run(&mut s, 40 * S);
+            assert!(s.fleet().values().all(|l| l.dimming == Some(60)));
+
+            let t = s.transport_mut().unwrap().simulator().unwrap();
+            t.lamp(5, LampAction::Fail);
+            t.lamp(8, LampAction::Cut);
+            let alerts = run(&mut s, 60 * S);
+            let about = |n: usize| {
+                alerts
+                    .iter()
+                    .filter(move |a| a.address == street_address(n))
+            };
+            assert!(
+                about(5).any(|a| a.what.starts_with("lamp failed")),
+                "{via:?}: {alerts:?}"
+            );
+            assert!(
+                about(8).any(|a| a.what.starts_with("stopped answering")),
+                "{via:?}: {alerts:?}"
+            );
+            assert!(s.fleet()[&street_address(5)].in_trouble());
+            assert!(s.fleet()[&street_address(8)].in_trouble());
+            assert!(!s.fleet()[&street_address(6)].in_trouble());
+        }
+    }
+}
