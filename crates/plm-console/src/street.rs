@@ -517,10 +517,12 @@ impl StreetSession {
                 self.sweep.done += sweep as usize;
             }
             (Purpose::Read(_, sweep), _) => self.sweep.done += sweep as usize,
-            (Purpose::Snr(a), Ok(Message::Service(Service::Sn(v)))) => {
-                if !matches!(self.conc.carrier(), plm_core::app::Carrier::Modem { .. }) {
-                    self.lamp(a).snr = Some(v as i8);
-                }
+            // Through a bare modem the SNR of each answer is better
+            // information than what the board heard.
+            (Purpose::Snr(a), Ok(Message::Service(Service::Sn(v))))
+                if !matches!(self.conc.carrier(), plm_core::app::Carrier::Modem { .. }) =>
+            {
+                self.lamp(a).snr = Some(v as i8);
             }
             (Purpose::Dim(a, level), Ok(Message::Ack { .. })) => {
                 self.lamp(a).dimming = Some(level);
