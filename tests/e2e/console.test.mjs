@@ -28,7 +28,7 @@ after(async () => {
 });
 
 /** A fresh page (and so a fresh simulated modem), failing on page errors. */
-async function open(t, hash = '') {
+async function open(t, hash = '#traffic') {
   const context = await browser.newContext({
     acceptDownloads: true,
     viewport: { width: 1400, height: 900 },

@@ -168,7 +168,7 @@ async function open(t, { nodes = 2 } = {}) {
     await sim.stop();
     assert.deepEqual(errors, [], 'no errors in the page');
   });
-  await page.goto(base);
+  await page.goto(base + '#traffic');
   // The simulated modem in the page is the default.
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   return { page, wire, sim, context };

@@ -7,6 +7,7 @@ use crate::views::data::DataView;
 use crate::views::diagnostics::DiagnosticsView;
 use crate::views::modem::ModemView;
 use crate::views::simulator::SimulatorView;
+use crate::views::street::StreetView;
 use crate::views::traffic::TrafficView;
 use leptos::prelude::*;
 use std::time::Duration;
@@ -18,6 +19,8 @@ const TICK: Duration = Duration::from_millis(4);
 /// The views, in the order of the tabs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Tab {
+    /// The street of lamps (the page opens on it).
+    Street,
     /// Traffic inspector.
     Traffic,
     /// MIB configuration.
@@ -32,7 +35,8 @@ pub enum Tab {
 
 impl Tab {
     /// Every tab.
-    pub const ALL: [Tab; 5] = [
+    pub const ALL: [Tab; 6] = [
+        Tab::Street,
         Tab::Traffic,
         Tab::Modem,
         Tab::Data,
@@ -43,6 +47,7 @@ impl Tab {
     /// The tab's name.
     pub fn label(self) -> &'static str {
         match self {
+            Tab::Street => "Street",
             Tab::Traffic => "Traffic",
             Tab::Modem => "Modem",
             Tab::Data => "Data",
@@ -54,6 +59,7 @@ impl Tab {
     /// The URL fragment that opens it (`#modem`).
     pub fn slug(self) -> &'static str {
         match self {
+            Tab::Street => "street",
             Tab::Traffic => "traffic",
             Tab::Modem => "modem",
             Tab::Data => "data",
@@ -67,7 +73,7 @@ impl Tab {
         Tab::ALL
             .into_iter()
             .find(|t| t.slug() == h)
-            .unwrap_or(Tab::Traffic)
+            .unwrap_or(Tab::Street)
     }
 }
 
@@ -122,6 +128,9 @@ pub fn App() -> impl IntoView {
             </nav>
             </div>
             <main>
+                <Panel tab=tab which=Tab::Street>
+                    <StreetView/>
+                </Panel>
                 <Panel tab=tab which=Tab::Traffic>
                     <TrafficView/>
                 </Panel>

@@ -11,6 +11,7 @@
 //! - [`app`], [`stores`], [`views`]: the Leptos application.
 //! - [`bench_hook`]: `window.plmBench`, for `cargo xtask bench`.
 
+pub mod fleet;
 pub mod mibform;
 pub mod session;
 pub mod street;

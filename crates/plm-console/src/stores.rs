@@ -3,6 +3,7 @@
 //! session's [`Note`]s to them.
 
 use crate::session::{Note, Outcome, Session, Tick};
+use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
 use crate::transport::{LinkState, Simulator};
@@ -73,6 +74,96 @@ pub struct SimStore {
     pub line_events: RwSignal<VecDeque<String>>,
 }
 
+/// Lamps on the simulated street the page opens on.
+pub const STREET_LAMPS: usize = 12;
+/// Alerts kept, newest first.
+pub const ALERTS: usize = 200;
+
+/// The Street view's state. The fleet itself stays in the session (500
+/// lamps with their histories are not copied at every answer); views read
+/// it with [`StreetStore::with_fleet`] when `version` changes.
+#[derive(Clone, Copy)]
+pub struct StreetStore {
+    session: StoredValue<Rc<RefCell<StreetSession>>, LocalStorage>,
+    /// Bumped whenever the fleet changed.
+    pub version: RwSignal<u64>,
+    /// Alerts, newest first.
+    pub alerts: RwSignal<VecDeque<Alert>>,
+    /// The background sweep.
+    pub sweep: RwSignal<Sweep>,
+    /// The discovery round running, if any.
+    pub discovering: RwSignal<Option<u8>>,
+    /// What the street is reached through, in words.
+    pub port: RwSignal<String>,
+    /// Application frames sent to the street so far.
+    pub sent: RwSignal<u64>,
+    /// The street's clock (µs), for "last seen".
+    pub now: RwSignal<Instant>,
+}
+
+impl StreetStore {
+    fn session(&self) -> Rc<RefCell<StreetSession>> {
+        self.session.get_value()
+    }
+
+    /// Reads the fleet.
+    pub fn with_fleet<R>(&self, f: impl FnOnce(&BTreeMap<plm_core::app::Address, Lamp>) -> R) -> R {
+        f(self.session().borrow().fleet())
+    }
+
+    /// Acts on the street session, then shows what changed.
+    pub fn act<R>(&self, f: impl FnOnce(&mut StreetSession) -> R) -> R {
+        let r = f(&mut self.session().borrow_mut());
+        let tick = self.session().borrow_mut().take();
+        self.apply(tick);
+        r
+    }
+
+    /// Lets the street's time catch up with the page's clock.
+    pub fn tick(&self) {
+        let tick = self.session().borrow_mut().tick(page_now_us());
+        self.apply(tick);
+    }
+
+    fn apply(&self, tick: StreetTick) {
+        let StreetTick {
+            changed,
+            alerts,
+            replies,
+            traffic,
+        } = tick;
+        let (sweep, discovering, now) = {
+            let session = self.session();
+            let s = session.borrow();
+            (s.sweep(), s.discovering(), s.now())
+        };
+        set_if_changed(self.sweep, sweep);
+        set_if_changed(self.discovering, discovering);
+        if changed {
+            self.now.set(now);
+            self.version.update(|v| *v += 1);
+        }
+        let sent = traffic
+            .iter()
+            .filter(|(_, d)| d.get("direction").and_then(|v| v.as_str()) == Some("request"))
+            .count() as u64;
+        if sent > 0 {
+            self.sent.update(|n| *n += sent);
+        }
+        if !alerts.is_empty() {
+            self.alerts.update(|l| {
+                for a in alerts {
+                    l.push_front(a);
+                }
+                l.truncate(ALERTS);
+            });
+        }
+        for (reply, r) in replies {
+            reply(r);
+        }
+    }
+}
+
 /// Everything the views share; `Copy`, provided by context.
 #[derive(Clone, Copy)]
 pub struct Console {
@@ -85,6 +176,8 @@ pub struct Console {
     pub modem: ModemStore,
     /// Simulator.
     pub sim: SimStore,
+    /// The street of lamps.
+    pub street: StreetStore,
 }
 
 /// The page's clock in µs.
@@ -123,9 +216,34 @@ pub fn provide_console() -> Console {
             echoed: RwSignal::new(0),
             line_events: RwSignal::new(VecDeque::new()),
         },
+        street: street_store(),
     };
     provide_context(console);
     console
+}
+
+/// The page opens on a simulated street behind a concentrator board's
+/// USART (DESIGN.md), and starts discovering it at once.
+fn street_store() -> StreetStore {
+    let transport = crate::transport::sim::SimTransport::street(
+        STREET_LAMPS,
+        plm_sim::Attach::Board,
+        57_600,
+        SIM_SEED,
+    );
+    let port = crate::transport::Transport::port(&transport);
+    let mut session = StreetSession::via_board(Box::new(transport));
+    session.discover();
+    StreetStore {
+        session: StoredValue::new_local(Rc::new(RefCell::new(session))),
+        version: RwSignal::new(0),
+        alerts: RwSignal::new(VecDeque::new()),
+        sweep: RwSignal::new(Sweep::default()),
+        discovering: RwSignal::new(Some(1)),
+        port: RwSignal::new(port),
+        sent: RwSignal::new(0),
+        now: RwSignal::new(0),
+    }
 }
 
 /// The console provided by the root component.
@@ -254,6 +372,7 @@ impl Console {
         let tick = self.session().borrow_mut().tick(page_now_us());
         self.apply(tick);
         self.refresh_sim();
+        self.street.tick();
     }
 
     /// Applies what happened without letting time pass.

@@ -10,6 +10,7 @@ pub mod modem;
 pub mod serial_port;
 pub mod simulator;
 pub mod snr_plot;
+pub mod street;
 pub mod traffic;
 
 use plm_core::time::Instant;

@@ -1,0 +1,220 @@
+//! The fleet table: one row per lamp as the Street view shows, sorts,
+//! filters and exports it (CSV and JSON). Pure, so its rules are tested
+//! natively.
+
+use crate::street::Lamp;
+use plm_core::app::hid::LampState;
+use plm_core::time::Instant;
+use serde_json::json;
+
+/// The columns, in order: (key, header).
+pub const COLUMNS: &[(&str, &str)] = &[
+    ("address", "Address"),
+    ("firmware", "Firmware"),
+    ("state", "Lamp"),
+    ("dimming", "Dimming %"),
+    ("power", "Power W"),
+    ("bus_voltage", "Bus V"),
+    ("lamp_voltage", "Lamp V"),
+    ("supply_voltage", "Supply V"),
+    ("temperature", "Temp °C"),
+    ("hours", "Hours"),
+    ("power_ons", "Power-ons"),
+    ("snr", "SNR dB"),
+    ("last_seen", "Last seen s"),
+];
+
+/// One lamp as a row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// 12 hex digits.
+    pub address: String,
+    /// `1.4`, empty when unknown.
+    pub firmware: String,
+    /// `RUN`, `FAILURE`, `UNREACHABLE`, or empty.
+    pub state: String,
+    /// Whether it needs a technician's eye.
+    pub trouble: bool,
+    /// Numbers by column key, `None` when unknown.
+    pub numbers: Vec<(&'static str, Option<f64>)>,
+}
+
+impl Row {
+    /// The row of `lamp`; `now` for how long ago it answered.
+    pub fn of(lamp: &Lamp, now: Instant) -> Row {
+        let b = lamp.ballast;
+        let n = |v: Option<f64>| v;
+        let state = match (&lamp.unreachable, lamp.state()) {
+            (Some(_), _) => "UNREACHABLE".to_string(),
+            (None, Some(s)) => s.name().to_string(),
+            (None, None) => String::new(),
+        };
+        Row {
+            address: lamp.address.to_string(),
+            firmware: lamp
+                .discovered
+                .map(|d| d.firmware.to_string())
+                .unwrap_or_default(),
+            trouble: lamp.in_trouble(),
+            state,
+            numbers: vec![
+                ("dimming", n(lamp.dimming.map(f64::from))),
+                ("power", b.map(|b| b.lamp_power as f64)),
+                ("bus_voltage", b.map(|b| b.bus_voltage as f64)),
+                ("lamp_voltage", b.map(|b| b.lamp_voltage as f64)),
+                ("supply_voltage", b.map(|b| b.supply_voltage as f64)),
+                ("temperature", b.map(|b| b.temperature as f64)),
+                ("hours", b.map(|b| b.lifetime_hours as f64)),
+                ("power_ons", b.map(|b| b.power_ons as f64)),
+                ("snr", lamp.snr.map(f64::from)),
+                (
+                    "last_seen",
+                    lamp.last_seen
+                        .map(|t| (now.saturating_sub(t) / 1_000_000) as f64),
+                ),
+            ],
+        }
+    }
+
+    /// The number in column `key`.
+    pub fn number(&self, key: &str) -> Option<f64> {
+        self.numbers
+            .iter()
+            .find(|(k, _)| *k == key)
+            .and_then(|(_, v)| *v)
+    }
+
+    /// The cell of column `key` as text.
+    pub fn cell(&self, key: &str) -> String {
+        match key {
+            "address" => self.address.clone(),
+            "firmware" => self.firmware.clone(),
+            "state" => self.state.clone(),
+            k => self.number(k).map(|v| format!("{v}")).unwrap_or_default(),
+        }
+    }
+
+    /// Whether the row matches a filter text (address, state or
+    /// firmware, case-insensitive; empty matches all).
+    pub fn matches(&self, filter: &str) -> bool {
+        let f = filter.trim().to_ascii_lowercase();
+        f.is_empty()
+            || self.address.contains(&f)
+            || self.state.to_ascii_lowercase().contains(&f)
+            || self.firmware.contains(&f)
+            || (f == "trouble" && self.trouble)
+    }
+}
+
+/// Sorts rows by column `key`; unknown values last.
+pub fn sort(rows: &mut [Row], key: &str, ascending: bool) {
+    rows.sort_by(|a, b| {
+        let o = match key {
+            "address" | "firmware" | "state" => a.cell(key).cmp(&b.cell(key)),
+            k => match (a.number(k), b.number(k)) {
+                (Some(x), Some(y)) => x.total_cmp(&y),
+                (Some(_), None) => return std::cmp::Ordering::Less,
+                (None, Some(_)) => return std::cmp::Ordering::Greater,
+                (None, None) => std::cmp::Ordering::Equal,
+            },
+        };
+        if ascending {
+            o
+        } else {
+            o.reverse()
+        }
+    });
+}
+
+/// The rows as CSV (RFC 4180: comma separated, header first, CRLF).
+pub fn to_csv(rows: &[Row]) -> String {
+    let mut s = COLUMNS.iter().map(|c| c.1).collect::<Vec<_>>().join(",");
+    s.push_str("\r\n");
+    for r in rows {
+        let cells: Vec<String> = COLUMNS.iter().map(|c| r.cell(c.0)).collect();
+        s.push_str(&cells.join(","));
+        s.push_str("\r\n");
+    }
+    s
+}
+
+/// The rows as a JSON array of objects keyed by column.
+pub fn to_json(rows: &[Row]) -> String {
+    let v: Vec<_> = rows
+        .iter()
+        .map(|r| {
+            let mut o = serde_json::Map::new();
+            o.insert("address".into(), json!(r.address));
+            o.insert("firmware".into(), json!(r.firmware));
+            o.insert("state".into(), json!(r.state));
+            o.insert("trouble".into(), json!(r.trouble));
+            for (k, v) in &r.numbers {
+                o.insert((*k).into(), json!(v));
+            }
+            serde_json::Value::Object(o)
+        })
+        .collect();
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// How a lamp state reads in the table's colours.
+pub fn state_class(state: &str) -> &'static str {
+    match state {
+        "RUN" => "lamp-run",
+        "FAILURE" | "UNREACHABLE" => "lamp-bad",
+        s if s == LampState::Idle.name() => "lamp-off",
+        "" => "",
+        _ => "lamp-busy",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plm_core::app::{Address, Ballast};
+
+    fn lamp(n: u64, power: u16, status: u16) -> Lamp {
+        Lamp {
+            address: Address::from_u64(0x0080_e100_0000 + n),
+            ballast: Some(Ballast {
+                lamp_power: power,
+                status,
+                ..Ballast::default()
+            }),
+            last_seen: Some(1_000_000),
+            ..Lamp::default()
+        }
+    }
+
+    #[test]
+    fn rows_sort_filter_and_export() {
+        let mut rows: Vec<Row> = [lamp(1, 150, 6), lamp(2, 0, 8), lamp(3, 75, 6)]
+            .iter()
+            .map(|l| Row::of(l, 11_000_000))
+            .collect();
+        sort(&mut rows, "power", true);
+        assert_eq!(
+            rows.iter().map(|r| r.cell("power")).collect::<Vec<_>>(),
+            ["0", "75", "150"]
+        );
+        assert!(rows[0].trouble && rows[0].state == "FAILURE");
+        assert_eq!(rows.iter().filter(|r| r.matches("fail")).count(), 1);
+        assert_eq!(rows.iter().filter(|r| r.matches("trouble")).count(), 1);
+        let csv = to_csv(&rows);
+        let lines: Vec<&str> = csv.split("\r\n").collect();
+        assert_eq!(lines[0], "Address,Firmware,Lamp,Dimming %,Power W,Bus V,Lamp V,Supply V,Temp °C,Hours,Power-ons,SNR dB,Last seen s");
+        assert!(
+            lines[1].starts_with("0080e1000002,,FAILURE,,0,"),
+            "{}",
+            lines[1]
+        );
+        assert!(
+            lines[1].ends_with(",10"),
+            "last seen 10 s ago: {}",
+            lines[1]
+        );
+        let json: serde_json::Value = serde_json::from_str(&to_json(&rows)).unwrap();
+        assert_eq!(json[2]["power"], 150.0);
+        assert_eq!(json[0]["trouble"], true);
+    }
+}

@@ -1,0 +1,133 @@
+// Browser end-to-end journeys of the Street view against the simulated
+// street the page opens on (12 lamps behind a concentrator board's USART).
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs/promises';
+import { launchChromium, serveDist, watchedPage } from './harness.mjs';
+import { shot } from './journeys.mjs';
+
+let server;
+let base;
+let browser;
+
+before(async () => {
+  ({ server, base } = await serveDist());
+  browser = await launchChromium();
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((r) => (server ? server.close(r) : r()));
+});
+
+const LAMPS = 12;
+const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
+const row = (page, n) => page.locator(`#fleet-table tbody tr[data-address="${lamp(n)}"]`);
+const cell = (page, n, key) => row(page, n).locator(`td[data-key="${key}"]`);
+const number = async (page, n, key) => Number(await cell(page, n, key).textContent());
+
+/** A fresh page, waiting until every lamp of the street was found and read. */
+async function open(t) {
+  const context = await browser.newContext({
+    acceptDownloads: true,
+    viewport: { width: 1400, height: 900 },
+  });
+  const page = await watchedPage(t, context);
+  await page.goto(base);
+  await page.locator('#view-street').waitFor({ state: 'visible' });
+  await page.waitForFunction(
+    (n) => {
+      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
+    },
+    LAMPS,
+    { timeout: 60_000, polling: 250 },
+  );
+  return page;
+}
+
+test('the page opens on the simulated street: every lamp found, read and lit', async (t) => {
+  const page = await open(t);
+  assert.equal(await page.getAttribute('#tab-street', 'aria-selected'), 'true');
+  assert.match(await page.textContent('#street-port'), /concentrator board \(simulated, 12 lamps\)/);
+  for (let n = 1; n <= LAMPS; n++) {
+    assert.equal(await cell(page, n, 'firmware').textContent(), '1.4');
+    assert.ok((await number(page, n, 'power')) > 0, `lamp ${n} draws power`);
+    assert.ok((await cell(page, n, 'snr').textContent()) !== '', `lamp ${n} has an SNR`);
+  }
+  await shot(page, 'street');
+});
+
+test('dim one lamp and see its power follow; dim all by broadcast', async (t) => {
+  const page = await open(t);
+  const before3 = await number(page, 3, 'power');
+  await row(page, 3).click();
+  await page.locator('#lamp-panel h3', { hasText: lamp(3) }).waitFor();
+  await page.fill('#lamp-dim-level', '20');
+  await page.click('#lamp-dim');
+  await page.waitForFunction(
+    ([sel, was]) => Number(document.querySelector(sel)?.textContent) < was,
+    [`#fleet-table tr[data-address="${lamp(3)}"] td[data-key="power"]`, before3],
+    { timeout: 30_000 },
+  );
+  assert.equal(await cell(page, 3, 'dimming').textContent(), '20');
+  await shot(page, 'street-lamp');
+
+  await page.fill('#street-dim-level', '40');
+  await page.click('#street-dim-all');
+  await page.locator('#street-message', { hasText: 'dimming 40 % sent to every lamp (broadcast)' }).waitFor();
+  // Power = rated × (0.5 + 0.5 × dimming / 100): 105 W at 40 % for 150 W lamps.
+  await page.waitForFunction(
+    (n) => {
+      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="power"]')];
+      return cells.length === n && cells.every((c) => Number(c.textContent) === 105);
+    },
+    LAMPS,
+    { timeout: 60_000, polling: 250 },
+  );
+});
+
+test('a failed lamp and an unreachable one are raised as alerts', async (t) => {
+  const page = await open(t);
+  await row(page, 5).click();
+  await page.click('#lamp-sim-fail');
+  await row(page, 9).click();
+  await page.click('#lamp-sim-cut');
+  const alerts = page.locator('#street-alerts');
+  await alerts.locator('li', { hasText: `${lamp(5)} lamp failed` }).waitFor({ timeout: 60_000 });
+  await alerts.locator('li', { hasText: `${lamp(9)} stopped answering` }).waitFor({ timeout: 60_000 });
+  assert.equal(await cell(page, 5, 'state').textContent(), 'FAILURE');
+  assert.equal(await cell(page, 9, 'state').textContent(), 'UNREACHABLE');
+  assert.match(await row(page, 5).getAttribute('class'), /trouble/);
+  await page.fill('#street-filter', 'trouble');
+  assert.equal(await page.locator('#fleet-table tbody tr').count(), 2);
+  await shot(page, 'street-alerts');
+});
+
+test('the fleet table exports to CSV', async (t) => {
+  const page = await open(t);
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#street-export-csv')]);
+  assert.equal(download.suggestedFilename(), 'street.csv');
+  const text = await fs.readFile(await download.path(), 'utf8');
+  const lines = text.trim().split('\r\n');
+  assert.equal(lines[0], 'Address,Firmware,Lamp,Dimming %,Power W,Bus V,Lamp V,Supply V,Temp °C,Hours,Power-ons,SNR dB,Last seen s');
+  assert.equal(lines.length, 1 + LAMPS);
+  assert.ok(lines.slice(1).every((l) => /^0080e1[0-9a-f]{6},1\.4,RUN,/.test(l)), lines.join('\n'));
+});
+
+test('a dimming value out of range is refused with the reason and nothing is sent', async (t) => {
+  const page = await open(t);
+  // Stop the background poll so that the count of frames sent stays still.
+  await page.uncheck('#street-sweep');
+  await page.waitForTimeout(3_000);
+  const sent = await page.textContent('#street-sent');
+  await page.fill('#street-dim-level', '150');
+  await page.click('#street-dim-all');
+  await page
+    .locator('#street-message', { hasText: 'nothing sent: dimming is 0 to 100 %, not 150' })
+    .waitFor();
+  await page.waitForTimeout(1_000);
+  assert.equal(await page.textContent('#street-sent'), sent);
+  await shot(page, 'street-refused');
+});
