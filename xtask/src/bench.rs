@@ -51,6 +51,20 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
+            name: "street: discover and read 100 lamps, sweep 500 (native)",
+            sources: &["crates/plm-sim/examples/bench_street.rs"],
+            cmd: Cmd::new("cargo").args([
+                "run",
+                "--profile",
+                "bench-native",
+                "-p",
+                "plm-sim",
+                "--example",
+                "bench_street",
+            ]),
+            needs_dist: false,
+        },
+        Bench {
             name: "console in Chromium: ACK latency, MIB-read rate, size",
             sources: &["tests/e2e/bench.mjs"],
             cmd: Cmd::new("node").args(["tests/e2e/bench.mjs"]),

@@ -91,6 +91,11 @@ struct SimArgs {
     /// the served modem (or the concentrator board with --board).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=500))]
     street: Option<u16>,
+    /// The street's lamps are already burning (RUN) when the simulation
+    /// powers on, instead of igniting and warming up for about half a
+    /// minute (for scripts and test benches that read lamps at once).
+    #[arg(long, conflicts_with = "nodes")]
+    warm: bool,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -138,11 +143,16 @@ fn sim(args: SimArgs) -> Result<(), String> {
         (true, n) => sim_server::World::Street {
             lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),
             attach: plm_sim::Attach::Board,
+            warm: args.warm,
         },
         (false, Some(n)) => sim_server::World::Street {
             lamps: n.into(),
             attach: plm_sim::Attach::Modem,
+            warm: args.warm,
         },
+        (false, None) if args.warm => {
+            return Err("--warm needs a street of lamps: add --street N or --board".into())
+        }
         (false, None) => sim_server::World::Modems(args.nodes.into()),
     };
     sim_server::run(sim_server::Options {

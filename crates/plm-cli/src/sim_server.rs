@@ -51,6 +51,9 @@ pub enum World {
         lamps: usize,
         /// What the client's bytes reach.
         attach: Attach,
+        /// The lamps are burning in RUN from the start (no ignition and
+        /// warm-up, `BallastConfig::warm_start`).
+        warm: bool,
     },
 }
 
@@ -79,8 +82,21 @@ pub fn run(opts: Options) -> Result<(), String> {
             },
             format!("simulated ST7580 (node 0 of {nodes}"),
         ),
-        World::Street { lamps, attach } => (
-            SimConfig::street(lamps, attach),
+        World::Street {
+            lamps,
+            attach,
+            warm,
+        } => (
+            {
+                let street = SimConfig::street(lamps, attach);
+                SimConfig {
+                    ballast: plm_sim::ballast::BallastConfig {
+                        warm_start: warm,
+                        ..street.ballast.clone()
+                    },
+                    ..street
+                }
+            },
             match attach {
                 Attach::Modem => format!("simulated ST7580 with a street of {lamps} lamps ("),
                 Attach::Board => {

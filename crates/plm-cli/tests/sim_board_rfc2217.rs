@@ -1,0 +1,413 @@
+//! `plm sim` serving a street of lamps, end to end: plm-core's
+//! [`Concentrator`] (the one the console and `plm board` drive) talks to
+//! the real binary over RFC 2217 in real time, through both ways in
+//! (DESIGN.md, connection profiles):
+//!
+//! - `--board`: a concentrator board's USART (application frames, no
+//!   T_REQ); its firmware carries them over the simulated power line;
+//! - `--chip st7580 --street N`: a bare ST7580 whose host is the
+//!   concentrator itself, T_REQ driven by RTS through RFC 2217
+//!   SET-CONTROL.
+//!
+//! Time is the wall clock since the connection, in microseconds, as the
+//! concentrator expects; every wait ends on a condition, bounded by
+//! generous limits. Lost frames are the requester's business (timeouts
+//! and retries), not the test's.
+
+mod common;
+
+use common::{com_port, escape, Link, Server, Telnet, RTS_OFF, RTS_ON, SET_CONTROL};
+use plm_core::app::hid::{self, Hid, LampState};
+use plm_core::app::service::{Discovered, Service};
+use plm_core::app::{
+    Address, AppEvent, Ballast, Concentrator, Discovery, FrameType, Happening, Message, Request,
+    RequesterConfig,
+};
+use plm_core::link::host::{Event, Transmit};
+use plm_core::st7580::TxParams;
+use plm_sim::board::{street_address, FIRMWARE};
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// The concentrator's own address: node 0 of a simulated street.
+const CONCENTRATOR: u64 = 0x0080_E100_0000;
+/// The longest the loop waits for bytes before it looks at the clock
+/// again: well under the 40 ms the modem gives the host to ACK a frame
+/// (UM0932 T_ACK).
+const TICK: Duration = Duration::from_millis(5);
+
+/// The concentrator driven over an RFC 2217 link in real time.
+struct Driver {
+    link: Link,
+    conc: Concentrator,
+    /// Wall-clock time of the concentrator's time 0.
+    start: Instant,
+    /// Values of the server's SET-CONTROL answers (RTS on/off), in order.
+    rts_answers: Vec<u8>,
+    /// Every happening so far, for failure messages.
+    log: Vec<Happening>,
+}
+
+impl Driver {
+    fn new(mut link: Link, conc: Concentrator) -> Driver {
+        link.agree();
+        Driver {
+            link,
+            conc,
+            start: Instant::now(),
+            rts_answers: Vec::new(),
+            log: Vec::new(),
+        }
+    }
+
+    /// Concentrator time: microseconds since the driver started.
+    fn now(&self) -> u64 {
+        self.start.elapsed().as_micros() as u64
+    }
+
+    /// Writes everything the concentrator has for the port as one TCP
+    /// write: data with IAC doubled, T_REQ as SET-CONTROL RTS.
+    fn flush(&mut self) {
+        let mut out = Vec::new();
+        while let Some(t) = self.conc.poll_transmit() {
+            match t {
+                Transmit::Bytes(b) => out.extend(escape(&b)),
+                Transmit::TReq { asserted } => {
+                    let value = if asserted { RTS_ON } else { RTS_OFF };
+                    out.extend(com_port(SET_CONTROL, &[value]));
+                }
+            }
+        }
+        if !out.is_empty() {
+            self.link.send(&out);
+        }
+    }
+
+    /// One turn: waits for bytes until the concentrator's next deadline
+    /// (at most [`TICK`]), feeds them at the time they were read, runs
+    /// what is due and sends what that produced.
+    fn step(&mut self) -> Vec<Happening> {
+        let now = self.now();
+        let wait = self
+            .conc
+            .poll_timeout()
+            .map_or(TICK, |t| Duration::from_micros(t.saturating_sub(now)))
+            .min(TICK);
+        self.link.pump(wait);
+        while let Some(t) = self.link.telnet.pop_front() {
+            if let Telnet::ComPort(c, value) = t {
+                if c == SET_CONTROL + 100 {
+                    self.rts_answers.extend(value);
+                }
+            }
+        }
+        let data = self.link.take_data();
+        let now = self.now();
+        if !data.is_empty() {
+            self.conc.handle_rx(now, &data);
+        }
+        if self.conc.poll_timeout().is_some_and(|t| t <= now) {
+            self.conc.handle_timeout(now);
+        }
+        self.flush();
+        let mut out = Vec::new();
+        while let Some(h) = self.conc.poll_happening() {
+            self.log.push(h.clone());
+            out.push(h);
+        }
+        out
+    }
+
+    /// Runs until `done` holds for a happening or `limit` passed.
+    fn run_until(&mut self, limit: Duration, mut done: impl FnMut(&Happening) -> bool) -> bool {
+        let until = Instant::now() + limit;
+        while Instant::now() < until {
+            if self.step().iter().any(&mut done) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Sends a request and waits for its fate (answer, failure, or sent).
+    fn request(&mut self, request: Request) -> AppEvent {
+        let id = self.conc.submit(self.now(), request.clone());
+        self.flush();
+        let mut fate = None;
+        // The requester gives up by itself after its attempts (1.5 s, then
+        // 3 s, then 4.5 s by default): this limit only guards the test.
+        self.run_until(Duration::from_secs(20), |h| match h {
+            Happening::App(
+                e @ (AppEvent::Answered { id: i, .. }
+                | AppEvent::Failed { id: i, .. }
+                | AppEvent::Sent { id: i }),
+            ) if *i == id => {
+                fate = Some(e.clone());
+                true
+            }
+            _ => false,
+        });
+        fate.unwrap_or_else(|| panic!("no fate for {request:?}; happenings: {:?}", self.log))
+    }
+
+    /// The answer of one board, or a panic saying why there is none.
+    fn ask(&mut self, to: Address, message: Message) -> Message {
+        match self.request(Request::to(to, message.clone())) {
+            AppEvent::Answered { answer, .. } => answer,
+            other => panic!("{to} did not answer {message:?}: {other:?}"),
+        }
+    }
+
+    /// A lamp's all-parameters reply (HID `'g'` 0Ah), decoded.
+    fn all_parameters(&mut self, to: Address) -> Ballast {
+        match self.ask(to, Message::Hid(Hid::Get(hid::ALL))) {
+            Message::Hid(Hid::Reply { param, value }) => {
+                assert_eq!(param, hid::ALL, "{to}: reply to another parameter");
+                Ballast::decode(&value)
+                    .unwrap_or_else(|| panic!("{to}: short all-parameters reply {value:02X?}"))
+            }
+            other => panic!("{to}: not a HID reply: {other:?}"),
+        }
+    }
+
+    /// Discovery in rounds, each reply acknowledged as it comes.
+    fn discover(&mut self, session: u8, window: u8, max_rounds: u8) -> (Discovery, usize) {
+        let (mut d, first) = Discovery::start(self.now(), session, window, max_rounds);
+        self.conc.submit(self.now(), first);
+        self.flush();
+        let mut replies = 0;
+        let give_up = Instant::now() + Duration::from_secs(40);
+        while !d.is_done() {
+            assert!(Instant::now() < give_up, "discovery did not end");
+            for h in self.step() {
+                if let Happening::App(AppEvent::Unsolicited {
+                    address, message, ..
+                }) = h
+                {
+                    if let Some(ack) = d.on_message(address, &message) {
+                        replies += 1;
+                        self.conc.send(self.now(), ack);
+                        self.flush();
+                    }
+                }
+            }
+            if let Some(next) = d.handle_timeout(self.now()) {
+                self.conc.submit(self.now(), next);
+                self.flush();
+            }
+        }
+        (d, replies)
+    }
+}
+
+/// `plm sim --board --street 5`: the concentrator board's USART reaches
+/// five lamps: discovered, read, dimmed one by one and all at once; the
+/// board answers for itself over its USART.
+#[test]
+fn concentrator_board_over_rfc2217_discovers_reads_and_dims_a_street() {
+    let mut server = Server::start(&[
+        "--board",
+        "--listen",
+        "127.0.0.1:0",
+        "--street",
+        "5",
+        "--seed",
+        "3",
+        "--warm",
+    ]);
+    assert!(
+        server.banner.contains("concentrator board") && server.banner.contains("5 lamps"),
+        "{}",
+        server.banner
+    );
+    let link = Link::connect(&server.addr);
+    server.line_containing("connected");
+    let mut d = Driver::new(link, Concentrator::usart(RequesterConfig::default()));
+
+    // 1. Discovery: every lamp answers once per session, is acknowledged,
+    // and nothing but the street's lamps answers.
+    let (discovery, replies) = d.discover(1, Discovery::window_for(5), 6);
+    let found: &BTreeMap<Address, Discovered> = discovery.found();
+    let lamps: Vec<Address> = (1..=5).map(street_address).collect();
+    assert_eq!(
+        found.keys().copied().collect::<Vec<_>>(),
+        lamps,
+        "found after {} round(s)",
+        discovery.round()
+    );
+    for (a, info) in found {
+        assert_eq!(info.firmware, FIRMWARE, "{a}: firmware release");
+    }
+    // Acknowledged lamps keep quiet for the rest of the session: only a
+    // lamp whose reply or acknowledgement was lost on the line answers
+    // again, once per later round.
+    assert!(
+        replies <= 5 * discovery.round() as usize,
+        "{replies} replies in {} round(s)",
+        discovery.round()
+    );
+
+    // 2. All parameters of lamp 2: burning, drawing power.
+    let lamp = street_address(2);
+    let full = d.all_parameters(lamp);
+    assert_eq!(full.state(), LampState::Run, "{full:?}");
+    assert!(full.lamp_power > 0, "{full:?}");
+
+    // 3. Dimmed to 40 % by a unicast command, acknowledged; the power
+    // drops.
+    let dim = Message::Hid(Hid::Dimming(40));
+    let ack = d.ask(lamp, dim.clone());
+    assert_eq!(ack, dim.ack(), "ACK of the dimming");
+    assert!(matches!(
+        ack,
+        Message::Ack {
+            frame_type: FrameType::Data,
+            echo: hid::SET
+        }
+    ));
+    let dimmed = d.all_parameters(lamp);
+    assert_eq!(dimmed.state(), LampState::Run, "{dimmed:?}");
+    assert!(
+        0 < dimmed.lamp_power && dimmed.lamp_power < full.lamp_power,
+        "{} W at 40 % vs {} W at 100 %",
+        dimmed.lamp_power,
+        full.lamp_power
+    );
+
+    // 4. A broadcast dimming to 70 %: sent without an answer; every lamp
+    // follows it (lamp 2 rises from 40 %, lamp 4 falls from 100 %).
+    let before4 = d.all_parameters(street_address(4));
+    let sent = d.request(Request::all(Message::Hid(Hid::Dimming(70))));
+    assert!(matches!(sent, AppEvent::Sent { .. }), "{sent:?}");
+    let after2 = d.all_parameters(lamp);
+    let after4 = d.all_parameters(street_address(4));
+    assert!(
+        after2.lamp_power > dimmed.lamp_power && after2.lamp_power < full.lamp_power,
+        "lamp 2: {} W at 70 %, {} W at 40 %, {} W at 100 %",
+        after2.lamp_power,
+        dimmed.lamp_power,
+        full.lamp_power
+    );
+    assert!(
+        after4.lamp_power < before4.lamp_power,
+        "lamp 4: {} W at 70 % vs {} W at 100 %",
+        after4.lamp_power,
+        before4.lamp_power
+    );
+
+    // 5. The concentrator board's own clock, answered over its USART: it
+    // powered on with the connection (RTC at midnight, virtual time 0).
+    let elapsed = d.start.elapsed().as_secs();
+    match d.ask(
+        Address::from_u64(CONCENTRATOR),
+        Message::Service(Service::ClockGet),
+    ) {
+        Message::Service(Service::ClockNow(c)) => {
+            let s = u64::from(c.seconds_of_day());
+            assert!(
+                s <= d.start.elapsed().as_secs() + 2 && s + 2 >= elapsed,
+                "concentrator clock {c} after {elapsed} s"
+            );
+        }
+        other => panic!("clock of the concentrator: {other:?}"),
+    }
+    assert!(
+        !d.log.iter().any(|h| matches!(
+            h,
+            Happening::App(AppEvent::Malformed { .. } | AppEvent::Failed { .. })
+        )),
+        "{:?}",
+        d.log
+    );
+
+    drop(d);
+    server.line_containing("disconnected");
+    server.interrupt();
+}
+
+/// `plm sim --chip st7580 --street 3`: the concentrator is the modem's
+/// host (T_REQ on RTS) and speaks the board protocol over the line
+/// itself: lamp 1 answers a ping.
+#[test]
+fn bare_st7580_over_rfc2217_pings_a_lamp_of_the_street() {
+    let mut server = Server::start(&[
+        "--chip",
+        "st7580",
+        "--street",
+        "3",
+        "--listen",
+        "127.0.0.1:0",
+    ]);
+    assert!(
+        server.banner.contains("ST7580") && server.banner.contains("3 lamps"),
+        "{}",
+        server.banner
+    );
+    let link = Link::connect(&server.addr);
+    server.line_containing("connected");
+    let conc = Concentrator::modem(
+        RequesterConfig::default(),
+        57_600,
+        Address::from_u64(CONCENTRATOR),
+        TxParams::default(),
+    );
+    let mut d = Driver::new(link, conc);
+
+    // The modem powered on with the connection: BIO_ResetIndication.
+    assert!(
+        d.run_until(Duration::from_secs(10), |h| matches!(
+            h,
+            Happening::Link(Event::Frame(f)) if f.code == 0x3E
+        )),
+        "no BIO_ResetIndication: {:?}",
+        d.log
+    );
+
+    let lamp = street_address(1);
+    let answer = d.ask(lamp, Message::Ping);
+    assert_eq!(
+        answer,
+        Message::Ack {
+            frame_type: FrameType::Ping,
+            echo: 0
+        }
+    );
+    // The answer crossed the line from lamp 1, and T_REQ went through
+    // RTS: every request asserted it and released it again.
+    assert!(
+        d.log
+            .iter()
+            .any(|h| matches!(h, Happening::Heard { address, .. } if *address == lamp)),
+        "{:?}",
+        d.log
+    );
+    assert!(
+        d.rts_answers.contains(&RTS_ON) && d.rts_answers.contains(&RTS_OFF),
+        "SET-CONTROL answers {:?}",
+        d.rts_answers
+    );
+    assert!(
+        d.log
+            .iter()
+            .any(|h| matches!(h, Happening::Link(Event::Delivered(_)))),
+        "the modem ACKed the DL_DataRequest: {:?}",
+        d.log
+    );
+
+    drop(d);
+    server.line_containing("disconnected");
+    server.interrupt();
+}
+
+/// `--warm` lights a street's lamps from the start: without a street it
+/// has nothing to light, and says so.
+#[test]
+fn warm_needs_a_street() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_plm"))
+        .args(["sim", "--warm", "--listen", "127.0.0.1:0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--street"), "{err}");
+}

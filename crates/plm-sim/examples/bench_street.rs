@@ -1,0 +1,138 @@
+//! `cargo xtask bench`, street part (DESIGN.md, Performance, "Street"):
+//!
+//! 1. Discovering and reading a street of 100 lamps through the
+//!    concentrator board's USART (`StreetDriver::discover`, then
+//!    `Hid::Get(ALL)` for every lamp, one after another), in simulated
+//!    seconds, against the channel limit: the airtime, at the modulation
+//!    in use (B-PSK, factory PHY_Config), of every frame that must cross
+//!    the line — the discovery broadcast, each lamp's discovery reply and
+//!    its acknowledgement, each read request and its reply — back to
+//!    back, with nothing between them.
+//! 2. Simulated seconds per wall second of a 500-lamp street while the
+//!    concentrator sweeps it (reads every 5th lamp, one after another, from
+//!    the nearest to the farthest: 100 reads), against real time, and the
+//!    wall time each read of the sweep costs.
+
+use plm_core::app::hid::{self, Hid};
+use plm_core::app::service::{Discovered, Service};
+use plm_core::app::{Discovery, LineFrame, Message, RequesterConfig};
+use plm_core::st7580::mib::{index, object, PhyConfig};
+use plm_core::st7580::{Modulation, TxParams};
+use plm_core::time::{Duration, MS};
+use plm_sim::board::{street_address, FIRMWARE, STACK};
+use plm_sim::line::airtime;
+use plm_sim::{Attach, Sim, SimConfig, StreetDriver};
+use std::time::Instant;
+
+const S: Duration = 1_000 * MS;
+
+fn street(lamps: usize) -> StreetDriver {
+    let sim = Sim::new(SimConfig {
+        seed: 5,
+        ..SimConfig::street(lamps, Attach::Board)
+    });
+    let mut d = StreetDriver::new(sim, RequesterConfig::default());
+    d.run_for(2 * S);
+    d
+}
+
+/// Reads the all-parameters of every `step`th lamp, one after another;
+/// returns the replies and how many reads failed.
+fn read_all(d: &mut StreetDriver, lamps: usize, step: usize) -> (Vec<Message>, usize) {
+    let (mut replies, mut failed) = (Vec::new(), 0);
+    for node in (step..=lamps).step_by(step) {
+        match d.ask(
+            street_address(node),
+            Message::Hid(Hid::Get(hid::ALL)),
+            60 * S,
+        ) {
+            Ok(m @ Message::Hid(Hid::Reply { .. })) => replies.push(m),
+            _ => failed += 1,
+        }
+    }
+    (replies, failed)
+}
+
+/// Airtime of one application message as a line frame: the line frame's
+/// bytes, the DL CRC (2) and the DL length byte (UM0932 2.3), at B-PSK.
+fn line_airtime(phy: &PhyConfig, m: &Message, broadcast: bool) -> Duration {
+    let app = if broadcast {
+        m.broadcast(street_address(0))
+    } else {
+        m.to(street_address(1))
+    };
+    let line = LineFrame::from_app(&app, street_address(0)).emit();
+    airtime(Modulation::BPsk, phy, line.len() + 2 + 1)
+}
+
+fn discover_and_read(lamps: usize) {
+    assert_eq!(TxParams::default().modulation, Modulation::BPsk);
+    let phy = PhyConfig::decode(object(index::PHY_CONFIG).expect("MIB 01h").default);
+    let mut d = street(lamps);
+    let start = d.now();
+    let wall = Instant::now();
+    let window = Discovery::window_for(lamps);
+    let found = d.discover(1, window, 12);
+    let discovered = d.now() - start;
+    let (replies, failed) = read_all(&mut d, lamps, 1);
+    let took = (d.now() - start) as f64 / 1e6;
+    let wall = wall.elapsed().as_secs_f64();
+
+    // The frames that must cross the line.
+    let discover = Message::Service(Service::Discover { session: 1, window });
+    let reply = Message::Service(Service::DiscoverReply(Discovered {
+        firmware: FIRMWARE,
+        stack: STACK,
+        snr: 0,
+    }));
+    let get = Message::Hid(Hid::Get(hid::ALL));
+    let mut limit = line_airtime(&phy, &discover, true);
+    limit += lamps as Duration
+        * (line_airtime(&phy, &reply, false)
+            + line_airtime(&phy, &reply.ack(), false)
+            + line_airtime(&phy, &get, false));
+    limit += replies
+        .iter()
+        .map(|m| line_airtime(&phy, m, false))
+        .sum::<Duration>();
+    // A read that failed still needed its reply on the line.
+    if let Some(m) = replies.first() {
+        limit += failed as Duration * line_airtime(&phy, m, false);
+    }
+    let limit = limit as f64 / 1e6;
+    println!(
+        "street discover+read {lamps} lamps: {took:.1} s simulated, channel limit {limit:.1} s, \
+         ratio {:.2} (discovery {:.1} s, window {window} s, {} of {lamps} found; \
+         {} read, {failed} failed; {wall:.2} s wall)",
+        limit / took,
+        discovered as f64 / 1e6,
+        found.len(),
+        replies.len(),
+    );
+}
+
+/// Sweeps every `step`th lamp of a street of `lamps` (the whole street
+/// would only repeat the same figure for longer).
+fn sweep(lamps: usize, step: usize) {
+    let mut d = street(lamps);
+    let start = d.now();
+    let wall = Instant::now();
+    let (replies, failed) = read_all(&mut d, lamps, step);
+    let reads = replies.len() + failed;
+    let wall = wall.elapsed().as_secs_f64();
+    let simulated = (d.now() - start) as f64 / 1e6;
+    let speed = simulated / wall;
+    println!(
+        "street of {lamps} lamps swept (all parameters of every {step}th lamp, one after \
+         another): {speed:.2} simulated seconds per wall second, ratio {speed:.2} against real \
+         time (1.0); {:.2} ms wall per read ({} read, {failed} failed, {simulated:.1} s \
+         simulated in {wall:.2} s wall)",
+        1e3 * wall / reads as f64,
+        replies.len(),
+    );
+}
+
+fn main() {
+    discover_and_read(100);
+    sweep(500, 5);
+}
