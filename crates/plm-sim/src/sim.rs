@@ -21,7 +21,7 @@ use plm_core::mib::MibError;
 use plm_core::st7580::{Channel, Command, Modulation, ResetCause, Temperature};
 use plm_core::time::{earliest, Duration, Instant};
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::{BTreeSet, BinaryHeap, VecDeque};
 
 /// How a simulation starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -292,6 +292,14 @@ pub struct Sim {
     usart_down: Wire,
     /// The concentrator board's USART to the outside host.
     usart_up: Wire,
+    /// Nodes whose components may have output or a new deadline: only
+    /// they are looked at after an event, so that a street of 500 costs
+    /// what its busy nodes do.
+    dirty: Vec<usize>,
+    is_dirty: Vec<bool>,
+    /// Each node's earliest component deadline, and all of them ordered.
+    deadlines: Vec<Option<Instant>>,
+    timers: BTreeSet<(Instant, usize)>,
 }
 
 impl Sim {
@@ -339,7 +347,7 @@ impl Sim {
                 }
             })
             .collect();
-        Sim {
+        let mut sim = Sim {
             now: 0,
             seq: 0,
             rng,
@@ -353,6 +361,43 @@ impl Sim {
             attach: config.attach,
             usart_down: Wire::new(config.baud),
             usart_up: Wire::new(config.baud),
+            dirty: Vec::new(),
+            is_dirty: Vec::new(),
+            deadlines: Vec::new(),
+            timers: BTreeSet::new(),
+        };
+        let n = sim.nodes.len();
+        sim.is_dirty = vec![false; n];
+        sim.deadlines = vec![None; n];
+        for i in 0..n {
+            sim.touch(i);
+        }
+        sim.flush();
+        sim
+    }
+
+    /// Marks `node` for the next [`Sim::flush`].
+    fn touch(&mut self, node: usize) {
+        if let Some(d) = self.is_dirty.get_mut(node) {
+            if !*d {
+                *d = true;
+                self.dirty.push(node);
+            }
+        }
+    }
+
+    /// Files `node`'s earliest deadline among the timers.
+    fn refresh_deadline(&mut self, node: usize) {
+        let n = &self.nodes[node];
+        let d = earliest(n.modem.poll_timeout(), n.host.poll_timeout());
+        if d != self.deadlines[node] {
+            if let Some(old) = self.deadlines[node] {
+                self.timers.remove(&(old, node));
+            }
+            if let Some(new) = d {
+                self.timers.insert((new, node));
+            }
+            self.deadlines[node] = d;
         }
     }
 
@@ -380,6 +425,7 @@ impl Sim {
             Host::Board(b) => Some(f(b, now)),
             _ => None,
         };
+        self.touch(node);
         self.flush();
         r
     }
@@ -423,7 +469,10 @@ impl Sim {
     /// Configures a MIB object of `node` directly, as its host would have
     /// (peers come up configured this way). Checked like a write.
     pub fn configure(&mut self, node: usize, index: u8, data: &[u8]) -> Result<(), MibError> {
-        self.nodes[node].modem.configure(index, data)
+        let r = self.nodes[node].modem.configure(index, data);
+        self.touch(node);
+        self.flush();
+        r
     }
 
     /// Makes the host of peer `node` (not 0) send `cmd` to its modem now,
@@ -433,6 +482,7 @@ impl Sim {
         if let Some(Host::Echo(app)) = self.nodes.get_mut(node).map(|n| &mut n.host) {
             app.submit(now, cmd);
         }
+        self.touch(node);
         self.flush();
     }
 
@@ -471,6 +521,7 @@ impl Sim {
             }
             Fault::Temperature(t) => self.nodes[0].modem.temperature = t,
         }
+        self.touch(0);
         self.flush();
     }
 
@@ -500,6 +551,8 @@ impl Sim {
         n.down.set_baud(baud);
         n.up.set_baud(baud);
         n.modem.set_baud(baud);
+        self.touch(0);
+        self.flush();
     }
 
     /// The host writes `bytes` to node 0's UART (or the concentrator
@@ -546,12 +599,10 @@ impl Sim {
     /// The next moment anything happens, byte arrivals at the host
     /// included: a driver that advances to it never misses a byte.
     pub fn next_deadline(&self) -> Option<Instant> {
-        let mut d = self.queue.peek().map(|s| s.0.at);
-        for n in &self.nodes {
-            d = earliest(d, n.modem.poll_timeout());
-            d = earliest(d, n.host.poll_timeout());
-        }
-        d
+        earliest(
+            self.queue.peek().map(|s| s.0.at),
+            self.timers.first().map(|t| t.0),
+        )
     }
 
     /// Runs everything due up to `t`, then sets the clock to `t`.
@@ -601,8 +652,15 @@ impl Sim {
             self.dispatch(s.ev);
             self.flush();
         }
-        let Sim { nodes, rng, .. } = self;
-        for n in nodes.iter_mut() {
+        let due: Vec<usize> = self
+            .timers
+            .iter()
+            .take_while(|t| t.0 <= now)
+            .map(|t| t.1)
+            .collect();
+        for i in due {
+            let Sim { nodes, rng, .. } = self;
+            let n = &mut nodes[i];
             if n.modem.poll_timeout().is_some_and(|d| d <= now) {
                 n.modem.handle_timeout(now);
             }
@@ -613,12 +671,21 @@ impl Sim {
                     Host::Board(b) => b.handle_timeout(now, rng),
                 }
             }
+            self.touch(i);
         }
         self.flush();
     }
 
     fn dispatch(&mut self, ev: Ev) {
         let now = self.now;
+        match &ev {
+            Ev::ToModem { node, .. } | Ev::ToHost { node, .. } | Ev::Treq { node, .. } => {
+                self.touch(*node)
+            }
+            Ev::RxEnd { node, .. } => self.touch(*node),
+            Ev::ToUsart { .. } => self.touch(0),
+            Ev::FromUsart { .. } | Ev::TxStart(_) => {}
+        }
         match ev {
             Ev::ToModem { node, byte } => {
                 if node > 0 || self.plugged {
@@ -651,10 +718,12 @@ impl Sim {
         }
     }
 
-    /// Moves what the modems and apps produced onto the UARTs and the line.
+    /// Moves what the touched modems and apps produced onto the UARTs and
+    /// the line, and files their new deadlines.
     fn flush(&mut self) {
         let now = self.now;
-        for i in 0..self.nodes.len() {
+        while let Some(i) = self.dirty.pop() {
+            self.is_dirty[i] = false;
             while let Some(bytes) = self.nodes[i].modem.poll_transmit() {
                 let arrivals = self.nodes[i].up.write(now, &bytes, &mut self.rng);
                 for (at, byte) in arrivals {
@@ -687,6 +756,7 @@ impl Sim {
                     }
                 }
             }
+            self.refresh_deadline(i);
         }
     }
 
@@ -705,6 +775,7 @@ impl Sim {
         for rx in &mut self.nodes[tx.from].rx {
             rx.collided = true;
         }
+        self.touch(tx.from);
         self.seq += 1;
         let id = self.seq;
         if self.nodes[tx.from].cut {
@@ -754,6 +825,7 @@ impl Sim {
                 collided,
             });
             n.modem.set_receiving(true);
+            self.touch(to);
             self.schedule(tx.end, Ev::RxEnd { node: to, id });
         }
     }

@@ -43,7 +43,7 @@ impl Default for RequesterConfig {
         RequesterConfig {
             timeout: 1_500 * MS,
             max_attempts: 3,
-            max_in_flight: 4,
+            max_in_flight: 1,
         }
     }
 }
@@ -403,7 +403,10 @@ mod tests {
 
     #[test]
     fn one_request_per_board_in_flight_and_broadcasts_need_no_answer() {
-        let mut r = Requester::new(RequesterConfig::default());
+        let mut r = Requester::new(RequesterConfig {
+            max_in_flight: 4,
+            ..RequesterConfig::default()
+        });
         let a = r.submit(0, Request::to(A, Message::Hid(Hid::Dimming(10))));
         let _b = r.submit(0, Request::to(A, Message::Hid(Hid::Dimming(20))));
         let c = r.submit(0, Request::all(Message::Hid(Hid::Dimming(30))));
