@@ -80,7 +80,7 @@ async function main() {
     const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
     const errors = pageErrors(page);
 
-    await page.goto(base + '#diagnostics');
+    await page.goto(base + '?profile=st7580#diagnostics');
     await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
     await page.waitForFunction(() => window.plmBench !== undefined);
     // The simulated modem has booted once its BIO_ResetIndication is in.

@@ -34,7 +34,7 @@ async function open(t, hash = '#traffic') {
     viewport: { width: 1400, height: 900 },
   });
   const page = await watchedPage(t, context);
-  await page.goto(base + hash);
+  await page.goto(base + '?profile=st7580' + hash);
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   return page;
 }

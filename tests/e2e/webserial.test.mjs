@@ -51,11 +51,12 @@ function ensurePlm() {
 }
 
 /**
- * Starts `plm sim --chip st7580 --listen 127.0.0.1:0 --nodes <n>` and waits
- * for the address it prints. Resolves to {host, port, stop()}.
+ * Starts `plm sim --listen 127.0.0.1:0` with `world` (by default a
+ * simulated ST7580 with `--nodes 2`) and waits for the address it prints.
+ * Resolves to {host, port, stop()}.
  */
-async function startSim(nodes = 2) {
-  const child = spawn(plmBin, ['sim', '--chip', 'st7580', '--listen', '127.0.0.1:0', '--nodes', String(nodes)], {
+async function startSim(world = ['--chip', 'st7580', '--nodes', '2']) {
+  const child = spawn(plmBin, ['sim', '--listen', '127.0.0.1:0', ...world], {
     stdio: ['ignore', 'pipe', 'pipe'],
   });
   const output = [];
@@ -151,8 +152,8 @@ after(async () => {
  * `nodes` modems (node 0 on the port, the others echo). Fails the test on
  * page errors.
  */
-async function open(t, { nodes = 2 } = {}) {
-  const sim = await startSim(nodes);
+async function open(t, { nodes = 2, world = ['--chip', 'st7580', '--nodes', String(nodes)], profile = 'st7580' } = {}) {
+  const sim = await startSim(world);
   const context = await browser.newContext({
     acceptDownloads: true,
     viewport: { width: 1400, height: 900 },
@@ -168,8 +169,8 @@ async function open(t, { nodes = 2 } = {}) {
     await sim.stop();
     assert.deepEqual(errors, [], 'no errors in the page');
   });
-  await page.goto(base + '#traffic');
-  // The simulated modem in the page is the default.
+  await page.goto(base + `?profile=${profile}#${profile === 'st7580' ? 'traffic' : 'street'}`);
+  // The simulated world of the profile is there first.
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   return { page, wire, sim, context };
 }
@@ -384,7 +385,7 @@ test('a browser without WebSerial is told so plainly, and the simulated modem st
     delete Navigator.prototype.serial;
   });
   const page = await watchedPage(t, context);
-  await page.goto(base);
+  await page.goto(base + '?profile=st7580');
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   assert.equal(await page.textContent('#serial-toggle'), 'WebSerial: not in this browser');
   await panel(page);
@@ -393,4 +394,33 @@ test('a browser without WebSerial is told so plainly, and the simulated modem st
   await shot(page, 'webserial-unavailable');
   await page.click('#serial-close');
   await ping(page);
+});
+
+test('WebSerial: a concentrator board on the port: its street is found, read and dimmed', async (t) => {
+  const { page, wire } = await open(t, { world: ['--board', '--street', '6', '--seed', '5'], profile: 'board' });
+  await connectSerial(page, { reset: false });
+  assert.match(await page.textContent('#street-port'), /WebSerial/);
+  // Discovery and the first sweep run over the real WebSerial transport.
+  await page.waitForFunction(
+    () => {
+      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+      return cells.length === 6 && cells.every((c) => c.textContent === 'RUN');
+    },
+    null,
+    { timeout: 60_000, polling: 250 },
+  );
+  const power = async () =>
+    Number(await page.textContent('#fleet-table tr[data-address="0080e1000002"] td[data-key="power"]'));
+  const before = await power();
+  await page.click('#fleet-table tr[data-address="0080e1000002"]');
+  await page.fill('#lamp-dim-level', '10');
+  await page.click('#lamp-dim');
+  await page.waitForFunction(
+    (was) => Number(document.querySelector('#fleet-table tr[data-address="0080e1000002"] td[data-key="power"]')?.textContent) < was,
+    before,
+    { timeout: 30_000 },
+  );
+  // A board's USART has no T_REQ: RTS is never asserted.
+  assert.equal(wire.clients.flatMap((c) => c.log).filter((e) => e.rts === true).length, 0);
+  await shot(page, 'webserial-street');
 });

@@ -91,11 +91,11 @@ struct SimArgs {
     /// the served modem (or the concentrator board with --board).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=500))]
     street: Option<u16>,
-    /// The street's lamps are already burning (RUN) when the simulation
-    /// powers on, instead of igniting and warming up for about half a
-    /// minute (for scripts and test benches that read lamps at once).
+    /// The street's lamps start cold when the simulation powers on:
+    /// they ignite and warm up for about half a minute (by default they
+    /// are already burning, as a street at work is).
     #[arg(long, conflicts_with = "nodes")]
-    warm: bool,
+    cold_lamps: bool,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -143,15 +143,15 @@ fn sim(args: SimArgs) -> Result<(), String> {
         (true, n) => sim_server::World::Street {
             lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),
             attach: plm_sim::Attach::Board,
-            warm: args.warm,
+            cold: args.cold_lamps,
         },
         (false, Some(n)) => sim_server::World::Street {
             lamps: n.into(),
             attach: plm_sim::Attach::Modem,
-            warm: args.warm,
+            cold: args.cold_lamps,
         },
-        (false, None) if args.warm => {
-            return Err("--warm needs a street of lamps: add --street N or --board".into())
+        (false, None) if args.cold_lamps => {
+            return Err("--cold-lamps needs a street of lamps: add --street N or --board".into())
         }
         (false, None) => sim_server::World::Modems(args.nodes.into()),
     };

@@ -51,9 +51,10 @@ pub enum World {
         lamps: usize,
         /// What the client's bytes reach.
         attach: Attach,
-        /// The lamps are burning in RUN from the start (no ignition and
-        /// warm-up, `BallastConfig::warm_start`).
-        warm: bool,
+        /// The lamps start cold: they ignite and warm up at power-on
+        /// (otherwise they burn in RUN from the start,
+        /// `BallastConfig::warm_start`).
+        cold: bool,
     },
 }
 
@@ -85,13 +86,13 @@ pub fn run(opts: Options) -> Result<(), String> {
         World::Street {
             lamps,
             attach,
-            warm,
+            cold,
         } => (
             {
                 let street = SimConfig::street(lamps, attach);
                 SimConfig {
                     ballast: plm_sim::ballast::BallastConfig {
-                        warm_start: warm,
+                        warm_start: !cold,
                         ..street.ballast.clone()
                     },
                     ..street

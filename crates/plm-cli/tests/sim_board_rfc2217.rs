@@ -213,7 +213,6 @@ fn concentrator_board_over_rfc2217_discovers_reads_and_dims_a_street() {
         "5",
         "--seed",
         "3",
-        "--warm",
     ]);
     assert!(
         server.banner.contains("concentrator board") && server.banner.contains("5 lamps"),
@@ -399,12 +398,12 @@ fn bare_st7580_over_rfc2217_pings_a_lamp_of_the_street() {
     server.interrupt();
 }
 
-/// `--warm` lights a street's lamps from the start: without a street it
-/// has nothing to light, and says so.
+/// `--cold-lamps` starts a street's lamps cold: without a street it has
+/// no lamps, and says so.
 #[test]
-fn warm_needs_a_street() {
+fn cold_lamps_need_a_street() {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_plm"))
-        .args(["sim", "--warm", "--listen", "127.0.0.1:0"])
+        .args(["sim", "--cold-lamps", "--listen", "127.0.0.1:0"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));

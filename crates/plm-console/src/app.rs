@@ -1,6 +1,7 @@
 //! The root component: the stores, the page's timer that drives the
 //! session, the connection bar and the views.
 
+use crate::profile::Profile;
 use crate::stores::{provide_console, use_console};
 use crate::views::connection_bar::ConnectionBar;
 use crate::views::data::DataView;
@@ -77,6 +78,13 @@ impl Tab {
     }
 }
 
+/// A parameter of the page's address (`?profile=st7580`).
+fn query(name: &str) -> Option<String> {
+    let search = web_sys::window()?.location().search().ok()?;
+    let params = web_sys::UrlSearchParams::new_with_str(&search).ok()?;
+    params.get(name)
+}
+
 fn current_hash() -> String {
     web_sys::window()
         .and_then(|w| w.location().hash().ok())
@@ -87,9 +95,12 @@ fn current_hash() -> String {
 #[component]
 pub fn App() -> impl IntoView {
     let console = provide_console();
-    // The simulated modem is there at once, so the page is useful on any
-    // machine (DESIGN.md).
-    console.connect_simulated(1);
+    // A simulated street is there at once, so a newcomer sees lamps on any
+    // machine (DESIGN.md); `?profile=st7580` opens on the simulated modem.
+    if let Some(p) = query("profile").and_then(|k| Profile::from_key(&k)) {
+        console.profile.set(p);
+    }
+    console.connect_simulated();
     crate::bench_hook::install(console);
     if let Ok(handle) = set_interval_with_handle(move || console.tick(), TICK) {
         on_cleanup(move || handle.clear());

@@ -84,7 +84,7 @@ impl Row {
             .and_then(|(_, v)| *v)
     }
 
-    /// The cell of column `key` as text.
+    /// The cell of column `key` as text (empty when unknown).
     pub fn cell(&self, key: &str) -> String {
         match key {
             "address" => self.address.clone(),

@@ -13,6 +13,7 @@
 
 pub mod fleet;
 pub mod mibform;
+pub mod profile;
 pub mod session;
 pub mod street;
 pub mod traffic;

@@ -2,13 +2,17 @@
 //! views by context as one [`Console`], and the one place that applies a
 //! session's [`Note`]s to them.
 
+use crate::profile::Profile;
 use crate::session::{Note, Outcome, Session, Tick};
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
+use crate::transport::Transport;
 use crate::transport::{LinkState, Simulator};
 use leptos::prelude::*;
+use plm_core::app::{Concentrator, RequesterConfig};
 use plm_core::link::Timeouts;
+use plm_core::st7580::TxParams;
 use plm_core::st7580::{Command, ErrorCause};
 use plm_core::time::Instant;
 use std::cell::RefCell;
@@ -88,7 +92,7 @@ pub struct StreetStore {
     /// Bumped whenever the fleet changed.
     pub version: RwSignal<u64>,
     /// Alerts, newest first.
-    pub alerts: RwSignal<VecDeque<Alert>>,
+    pub alerts: RwSignal<VecDeque<Raised>>,
     /// The background sweep.
     pub sweep: RwSignal<Sweep>,
     /// The discovery round running, if any.
@@ -111,57 +115,36 @@ impl StreetStore {
         f(self.session().borrow().fleet())
     }
 
-    /// Acts on the street session, then shows what changed.
+    /// Acts on the street session; the console shows what changed at
+    /// its next tick.
     pub fn act<R>(&self, f: impl FnOnce(&mut StreetSession) -> R) -> R {
-        let r = f(&mut self.session().borrow_mut());
-        let tick = self.session().borrow_mut().take();
-        self.apply(tick);
-        r
+        f(&mut self.session().borrow_mut())
     }
+}
 
-    /// Lets the street's time catch up with the page's clock.
-    pub fn tick(&self) {
-        let tick = self.session().borrow_mut().tick(page_now_us());
-        self.apply(tick);
-    }
+/// An alert with the computer's time when it was raised.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Raised {
+    /// `HH:MM:SS`, the computer's local time.
+    pub wall: String,
+    /// The alert.
+    pub alert: Alert,
+}
 
-    fn apply(&self, tick: StreetTick) {
-        let StreetTick {
-            changed,
-            alerts,
-            replies,
-            traffic,
-        } = tick;
-        let (sweep, discovering, now) = {
-            let session = self.session();
-            let s = session.borrow();
-            (s.sweep(), s.discovering(), s.now())
-        };
-        set_if_changed(self.sweep, sweep);
-        set_if_changed(self.discovering, discovering);
-        if changed {
-            self.now.set(now);
-            self.version.update(|v| *v += 1);
-        }
-        let sent = traffic
-            .iter()
-            .filter(|(_, d)| d.get("direction").and_then(|v| v.as_str()) == Some("request"))
-            .count() as u64;
-        if sent > 0 {
-            self.sent.update(|n| *n += sent);
-        }
-        if !alerts.is_empty() {
-            self.alerts.update(|l| {
-                for a in alerts {
-                    l.push_front(a);
-                }
-                l.truncate(ALERTS);
-            });
-        }
-        for (reply, r) in replies {
-            reply(r);
-        }
+/// The computer's local time of day, `HH:MM:SS`.
+pub fn wall_clock() -> String {
+    #[cfg(target_arch = "wasm32")]
+    {
+        let d = js_sys::Date::new_0();
+        format!(
+            "{:02}:{:02}:{:02}",
+            d.get_hours(),
+            d.get_minutes(),
+            d.get_seconds()
+        )
     }
+    #[cfg(not(target_arch = "wasm32"))]
+    String::from("--:--:--")
 }
 
 /// Everything the views share; `Copy`, provided by context.
@@ -178,6 +161,8 @@ pub struct Console {
     pub sim: SimStore,
     /// The street of lamps.
     pub street: StreetStore,
+    /// What the console is connected to.
+    pub profile: RwSignal<Profile>,
 }
 
 /// The page's clock in µs.
@@ -216,34 +201,20 @@ pub fn provide_console() -> Console {
             echoed: RwSignal::new(0),
             line_events: RwSignal::new(VecDeque::new()),
         },
-        street: street_store(),
+        street: StreetStore {
+            session: StoredValue::new_local(Rc::new(RefCell::new(StreetSession::idle()))),
+            version: RwSignal::new(0),
+            alerts: RwSignal::new(VecDeque::new()),
+            sweep: RwSignal::new(Sweep::default()),
+            discovering: RwSignal::new(None),
+            port: RwSignal::new(String::new()),
+            sent: RwSignal::new(0),
+            now: RwSignal::new(0),
+        },
+        profile: RwSignal::new(Profile::default()),
     };
     provide_context(console);
     console
-}
-
-/// The page opens on a simulated street behind a concentrator board's
-/// USART (DESIGN.md), and starts discovering it at once.
-fn street_store() -> StreetStore {
-    let transport = crate::transport::sim::SimTransport::street(
-        STREET_LAMPS,
-        plm_sim::Attach::Board,
-        57_600,
-        SIM_SEED,
-    );
-    let port = crate::transport::Transport::port(&transport);
-    let mut session = StreetSession::via_board(Box::new(transport));
-    session.discover();
-    StreetStore {
-        session: StoredValue::new_local(Rc::new(RefCell::new(session))),
-        version: RwSignal::new(0),
-        alerts: RwSignal::new(VecDeque::new()),
-        sweep: RwSignal::new(Sweep::default()),
-        discovering: RwSignal::new(Some(1)),
-        port: RwSignal::new(port),
-        sent: RwSignal::new(0),
-        now: RwSignal::new(0),
-    }
 }
 
 /// The console provided by the root component.
@@ -277,15 +248,61 @@ impl Console {
         self.session.get_value()
     }
 
-    /// Connects to a simulated modem with `nodes - 1` echoing peers.
-    pub fn connect_simulated(&self, nodes: usize) {
+    /// Connects the simulated world of the current profile: a street of
+    /// [`STREET_LAMPS`] lamps, or a modem with `sim.nodes - 1` echoing
+    /// peers.
+    pub fn connect_simulated(&self) {
+        let profile = self.profile.get_untracked();
         let baud = self.conn.baud.get_untracked();
-        let t = SimTransport::new(nodes, baud, SIM_SEED);
-        self.session()
-            .borrow_mut()
-            .replace_transport(Some(Box::new(t)));
-        self.sim.nodes.set(nodes);
+        let t: Box<dyn Transport> = if profile.is_street() {
+            Box::new(SimTransport::street(
+                STREET_LAMPS,
+                profile.attach(),
+                baud,
+                SIM_SEED,
+            ))
+        } else {
+            Box::new(SimTransport::new(
+                self.sim.nodes.get_untracked(),
+                baud,
+                SIM_SEED,
+            ))
+        };
         self.sim.line_events.set(VecDeque::new());
+        self.connect_transport(t);
+    }
+
+    /// Connects over `transport` (the simulated world, or a WebSerial
+    /// port the port chooser opened, `views::serial_port`) with the
+    /// current profile; the other session lets go of its transport.
+    pub fn connect_transport(&self, transport: Box<dyn Transport>) {
+        let profile = self.profile.get_untracked();
+        if profile.is_street() {
+            self.session().borrow_mut().replace_transport(None);
+            let baud = transport.baud();
+            let conc = match profile {
+                Profile::StreetBoard => Concentrator::usart(RequesterConfig::default()),
+                _ => Concentrator::modem(
+                    RequesterConfig::default(),
+                    baud,
+                    plm_sim::board::street_address(0),
+                    TxParams::default(),
+                ),
+            };
+            self.street.port.set(transport.port());
+            let mut street = StreetSession::new(transport, conc);
+            street.discover();
+            *self.street.session().borrow_mut() = street;
+            self.street.alerts.set(VecDeque::new());
+            self.street.sent.set(0);
+        } else {
+            *self.street.session().borrow_mut() = StreetSession::idle();
+            self.street.port.set(String::new());
+            self.session()
+                .borrow_mut()
+                .replace_transport(Some(transport));
+        }
+        self.street.version.update(|v| *v += 1);
         self.modem.mib.set(BTreeMap::new());
         self.modem.status.set(None);
         self.conn.retries.set(0);
@@ -293,28 +310,29 @@ impl Console {
         self.refresh();
     }
 
-    /// Connects over `transport` (a WebSerial port the port chooser opened,
-    /// `views::serial_port`).
-    pub fn connect_transport(&self, transport: Box<dyn crate::transport::Transport>) {
-        self.session()
-            .borrow_mut()
-            .replace_transport(Some(transport));
-        self.modem.mib.set(BTreeMap::new());
-        self.modem.status.set(None);
-        self.conn.retries.set(0);
-        self.conn.last_problem.set(None);
-        self.refresh();
+    /// Changes the profile and connects its simulated world.
+    pub fn set_profile(&self, profile: Profile) {
+        if self.profile.get_untracked() != profile {
+            self.profile.set(profile);
+            self.traffic.log.update(|l| l.clear());
+        }
+        self.connect_simulated();
     }
 
     /// Closes the connection.
     pub fn disconnect(&self) {
         self.session().borrow_mut().replace_transport(None);
+        *self.street.session().borrow_mut() = StreetSession::idle();
+        self.street.port.set(String::new());
         self.refresh();
     }
 
     /// Changes the baud rate.
     pub fn set_baud(&self, baud: u32) {
         self.session().borrow_mut().set_baud(baud);
+        if let Some(t) = self.street.session().borrow_mut().transport_mut() {
+            t.set_baud(baud);
+        }
         self.conn.baud.set(baud);
         self.refresh();
     }
@@ -354,8 +372,15 @@ impl Console {
     pub fn with_simulator(&self, f: impl FnOnce(&mut dyn Simulator)) {
         {
             let session = self.session();
+            let street = self.street.session();
             let mut s = session.borrow_mut();
-            if let Some(sim) = s.transport_mut().and_then(|t| t.simulator()) {
+            let mut st = street.borrow_mut();
+            let t = if self.profile.get_untracked().is_street() {
+                st.transport_mut()
+            } else {
+                s.transport_mut()
+            };
+            if let Some(sim) = t.and_then(|t| t.simulator()) {
                 f(sim);
             }
         }
@@ -371,8 +396,9 @@ impl Console {
     pub fn tick(&self) {
         let tick = self.session().borrow_mut().tick(page_now_us());
         self.apply(tick);
+        let street = self.street.session().borrow_mut().tick(page_now_us());
+        self.apply_street(street);
         self.refresh_sim();
-        self.street.tick();
     }
 
     /// Applies what happened without letting time pass.
@@ -381,10 +407,25 @@ impl Console {
             let session = self.session();
             let mut s = session.borrow_mut();
             let tick = s.take();
-            let (kind, port) = s.transport().map_or((String::new(), String::new()), |t| {
+            let street = self.street.session();
+            let mut st = street.borrow_mut();
+            let t = if self.profile.get_untracked().is_street() {
+                st.transport_mut().map(|t| &*t)
+            } else {
+                s.transport()
+            };
+            let (kind, port) = t.map_or((String::new(), String::new()), |t| {
                 (t.kind().into(), t.port())
             });
-            (tick, s.state(), kind, port)
+            let state = if self.profile.get_untracked().is_street() {
+                st.state()
+            } else {
+                s.state()
+            };
+            let street_tick = st.take();
+            drop(st);
+            self.apply_street(street_tick);
+            (tick, state, kind, port)
         };
         set_if_changed(self.conn.state, state);
         set_if_changed(self.conn.kind, kind);
@@ -396,9 +437,15 @@ impl Console {
     fn refresh_sim(&self) {
         let (events, echoed, plugged, state) = {
             let session = self.session();
+            let street = self.street.session();
             let mut s = session.borrow_mut();
-            let state = s.state();
-            match s.transport_mut().and_then(|t| t.simulator()) {
+            let mut st = street.borrow_mut();
+            let (state, t) = if self.profile.get_untracked().is_street() {
+                (st.state(), st.transport_mut())
+            } else {
+                (s.state(), s.transport_mut())
+            };
+            match t.and_then(|t| t.simulator()) {
                 Some(sim) => (sim.line_events(), sim.echoed(), sim.plugged(), Some(state)),
                 None => (Vec::new(), 0, true, None),
             }
@@ -417,6 +464,55 @@ impl Console {
                     }
                 }
             });
+        }
+    }
+
+    /// Applies what the street session did to the stores, then calls its
+    /// replies (the session is not borrowed any more).
+    fn apply_street(&self, tick: StreetTick) {
+        let StreetTick {
+            changed,
+            alerts,
+            replies,
+            traffic,
+            sent,
+        } = tick;
+        let (sweep, discovering, now) = {
+            let session = self.street.session();
+            let s = session.borrow();
+            (s.sweep(), s.discovering(), s.now())
+        };
+        let street = self.street;
+        set_if_changed(street.sweep, sweep);
+        set_if_changed(street.discovering, discovering);
+        if changed {
+            street.now.set(now);
+            street.version.update(|v| *v += 1);
+        }
+        if sent > 0 {
+            street.sent.update(|n| *n += sent);
+        }
+        if !traffic.is_empty() {
+            self.traffic.log.update(|log| {
+                for (at, d) in traffic {
+                    log.push(Some(at), d);
+                }
+            });
+        }
+        if !alerts.is_empty() {
+            let wall = wall_clock();
+            street.alerts.update(|l| {
+                for alert in alerts {
+                    l.push_front(Raised {
+                        wall: wall.clone(),
+                        alert,
+                    });
+                }
+                l.truncate(ALERTS);
+            });
+        }
+        for (reply, r) in replies {
+            reply(r);
         }
     }
 

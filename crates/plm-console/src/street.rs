@@ -14,7 +14,9 @@ use plm_core::app::{
     Address, AppEvent, Ballast, Concentrator, Discovery, Happening, Message, Request, RequestId,
     RequesterConfig,
 };
-use plm_core::link::host::Transmit;
+use plm_core::decode::{Decoded, Decoder};
+use plm_core::link::host::{self, Transmit};
+use plm_core::link::{Dialect, Element, Source};
 use plm_core::time::{Duration, Instant, MS};
 use std::collections::{BTreeMap, HashMap, VecDeque};
 
@@ -118,7 +120,9 @@ pub struct StreetTick {
     pub replies: Vec<(StreetReply, Result<Message, String>)>,
     /// Frames on the wire (USART elements, or the modem's link), as
     /// `plm decode` names them, with their times.
-    pub traffic: Vec<(Instant, serde_json::Value)>,
+    pub traffic: Vec<(Instant, Decoded)>,
+    /// Frames the console sent towards the street.
+    pub sent: u64,
 }
 
 /// The street session.
@@ -133,6 +137,8 @@ pub struct StreetSession {
     next_sweep: Option<Instant>,
     fleet: BTreeMap<Address, Lamp>,
     purposes: HashMap<RequestId, Purpose>,
+    /// Names the modem's host-interface traffic (bare modem profile).
+    decoder: Decoder,
     out: StreetTick,
 }
 
@@ -151,8 +157,19 @@ impl StreetSession {
             next_sweep: None,
             fleet: BTreeMap::new(),
             purposes: HashMap::new(),
+            decoder: Decoder::new(Dialect::St7580, Source::Any),
             out: StreetTick::default(),
         }
+    }
+
+    /// A session with nothing connected (another profile is in use).
+    pub fn idle() -> Self {
+        let mut s = Self::new(
+            Box::new(crate::transport::sim::SimTransport::new(1, 57_600, 0)),
+            Concentrator::usart(RequesterConfig::default()),
+        );
+        s.transport = None;
+        s
     }
 
     /// A session through a concentrator board's USART.
@@ -389,13 +406,26 @@ impl StreetSession {
                         l.snr = snr.or(l.snr);
                     }
                 }
-                Happening::Usart { element, .. } => {
+                Happening::Usart { to_board, element } => {
                     let d = plm_core::decode_app::decode_element(&element);
-                    self.out.traffic.push((now, d.to_json()));
+                    let from = if to_board { "host" } else { "board" };
+                    self.out.sent += to_board as u64;
+                    self.out.traffic.push((now, d.to_decoded(from)));
                 }
+                Happening::Link(host::Event::Sent(el)) => {
+                    self.out.sent += matches!(el, Element::Frame { .. }) as u64;
+                    self.link_traffic(now, &el, "host");
+                }
+                Happening::Link(host::Event::Received(el)) => self.link_traffic(now, &el, "modem"),
                 Happening::Link(_) => {}
             }
         }
+    }
+
+    fn link_traffic(&mut self, now: Instant, el: &Element, from: &str) {
+        let mut d = self.decoder.decode(el);
+        d.from = Some(from.to_string());
+        self.out.traffic.push((now, d));
     }
 
     fn lamp(&mut self, a: Address) -> &mut Lamp {

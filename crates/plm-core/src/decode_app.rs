@@ -108,6 +108,43 @@ impl AppDecoded {
         serde_json::to_value(self).unwrap_or(Json::Null)
     }
 
+    /// The same element in the modem decoder's shape, so that one traffic
+    /// inspector (and its export) shows both: `from` is who sent it
+    /// (`host` or `board`); the command is the frame's name, the checksum
+    /// its CRC-16, and the address, frame type, broadcast flag and
+    /// direction lead its fields.
+    pub fn to_decoded(&self, from: &str) -> crate::decode::Decoded {
+        let mut fields = Map::new();
+        let mut put = |k: &str, v: Option<Json>| {
+            if let Some(v) = v {
+                fields.insert(k.to_string(), v);
+            }
+        };
+        put("address", self.address.clone().map(Json::String));
+        put("destination", self.destination.clone().map(Json::String));
+        put("source", self.source.clone().map(Json::String));
+        put("frame_type", self.frame_type.clone());
+        put("broadcast", self.broadcast.map(Json::Bool));
+        put("direction", self.direction.clone().map(Json::String));
+        if let Some(f) = &self.fields {
+            fields.extend(f.clone());
+        }
+        crate::decode::Decoded {
+            kind: self.kind.clone(),
+            from: Some(from.to_string()),
+            hex: self.hex.clone(),
+            stx: None,
+            length: self.length,
+            code: None,
+            command: self.command.clone().or_else(|| self.frame_type.clone()),
+            checksum: self.crc,
+            checksum_ok: self.crc_ok,
+            fields: Some(fields),
+            error: self.error.clone(),
+            reason: None,
+        }
+    }
+
     /// Type, broadcast flag, command, direction, fields and error of a
     /// frame's type byte and payload.
     fn put_payload(&mut self, frame_type: FrameType, broadcast: bool, payload: &[u8]) {

@@ -66,6 +66,12 @@ impl SimConfig {
             line: LineConfig::street(lamps),
             attach: via,
             peers: Peers::Street,
+            // The lamps were lit before the simulation began, so that a
+            // newcomer sees a street at work at once.
+            ballast: BallastConfig {
+                warm_start: true,
+                ..BallastConfig::default()
+            },
             ..SimConfig::default()
         }
     }

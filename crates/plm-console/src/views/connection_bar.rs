@@ -1,7 +1,8 @@
-//! The connection bar, always visible: state, transport (with the
-//! WebSerial port chooser) and port, baud,
-//! chip, T_REQ level, the link's repeats and its timeouts.
+//! The connection bar, always visible: what the console is connected to
+//! (the profile), state, transport (with the WebSerial port chooser) and
+//! port, baud, T_REQ level, the link's repeats and its timeouts.
 
+use crate::profile::Profile;
 use crate::stores::use_console;
 use crate::transport::LinkState;
 use leptos::prelude::*;
@@ -13,8 +14,31 @@ pub fn ConnectionBar() -> impl IntoView {
     let c = use_console();
     let conn = c.conn;
     let connected = move || conn.state.with(LinkState::is_connected);
+    let profile = c.profile;
+    let modem = move || profile.get() == Profile::Modem;
     view! {
         <div class="conn" id="connection" aria-label="Connection">
+            <label title="What is at the other end of the serial port. Changing it restarts the simulated world (or reconnects the port with the new profile).">
+                <select
+                    id="profile"
+                    on:change=move |ev| {
+                        if let Some(p) = Profile::from_key(&event_target_value(&ev)) {
+                            c.set_profile(p);
+                        }
+                    }
+                >
+                    {Profile::ALL
+                        .into_iter()
+                        .map(|p| {
+                            view! {
+                                <option value=p.key() selected=move || profile.get() == p>
+                                    {p.label()}
+                                </option>
+                            }
+                        })
+                        .collect_view()}
+                </select>
+            </label>
             <span
                 id="conn-state"
                 class="state"
@@ -29,13 +53,14 @@ pub fn ConnectionBar() -> impl IntoView {
             <span
                 class="item"
                 id="conn-transport"
-                title="Where the bytes go: the simulated modem in this page, or a real modem over WebSerial (the button beside it)"
+                title="Where the bytes go: the simulated world in this page, or a real modem or board over WebSerial (the button beside it)"
             >
                 "Transport "
                 <b>
                     {move || match conn.kind.get().as_str() {
                         "" => "none".to_string(),
-                        "Simulated" => "simulated modem".to_string(),
+                        "Simulated" if modem() => "simulated modem".to_string(),
+                        "Simulated" => "simulated street".to_string(),
                         other => other.to_string(),
                     }}
                 </b>
@@ -64,8 +89,11 @@ pub fn ConnectionBar() -> impl IntoView {
                         .collect_view()}
                 </select>
             </label>
-            <span class="item">"Chip " <b>"ST7580"</b></span>
-            <span class="item" id="conn-treq" title="T_REQ: low = the host asks to send">
+            <span class="item">
+                {move || if profile.get() == Profile::StreetBoard { "Board " } else { "Chip " }}
+                <b>{move || if profile.get() == Profile::StreetBoard { "STEVAL-IHP007V1 USART" } else { "ST7580" }}</b>
+            </span>
+            <span class="item" id="conn-treq" title="T_REQ: low = the host asks to send" hidden=move || !modem()>
                 "T_REQ "
                 <b class:low=move || conn.treq.get()>
                     {move || if conn.treq.get() { "low" } else { "high" }}
@@ -85,7 +113,7 @@ pub fn ConnectionBar() -> impl IntoView {
                     "Repeats " <b>{move || conn.retries.get()}</b>
                 </span>
             </Show>
-            <span class="item muted" title="Host-interface timeouts (MIB 09h)">
+            <span class="item muted" title="Host-interface timeouts (MIB 09h)" hidden=move || !modem()>
                 {move || {
                     let t = conn.timeouts.get();
                     format!(
@@ -100,7 +128,7 @@ pub fn ConnectionBar() -> impl IntoView {
                 id="connect"
                 on:click=move |_| {
                     if c.conn.kind.get_untracked().is_empty() {
-                        c.connect_simulated(c.sim.nodes.get_untracked());
+                        c.connect_simulated();
                     } else {
                         c.disconnect();
                     }

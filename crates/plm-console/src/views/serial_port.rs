@@ -219,7 +219,7 @@ mod wasm {
         /// Back to the simulated modem (closing the port).
         fn use_simulator(self) {
             let c = self.console;
-            c.connect_simulated(c.sim.nodes.get_untracked());
+            c.connect_simulated();
             self.message.set(None);
             self.open.set(false);
         }

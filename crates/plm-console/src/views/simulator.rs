@@ -98,7 +98,10 @@ fn TopologyCard() -> impl IntoView {
                         .collect_view()}
                 </select>
             </label>
-            <button id="sim-apply-topology" on:click=move |_| c.connect_simulated(choice.get_untracked())>
+            <button id="sim-apply-topology" on:click=move |_| {
+                c.sim.nodes.set(choice.get_untracked());
+                c.set_profile(crate::profile::Profile::Modem);
+            }>
                 "Restart the simulation"
             </button>
             <p>

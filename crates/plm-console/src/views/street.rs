@@ -67,7 +67,7 @@ pub fn StreetView() -> impl IntoView {
                 <p class="message" id="street-message">{move || message.get().unwrap_or_default()}</p>
             </Show>
             <Alerts focus=focus/>
-            <div class="street-grid">
+            <div class="street-grid" class:with-lamp=move || focus.with(|f| f.is_some())>
                 <div class="table-wrap">
                     <table class="log fleet" id="fleet-table">
                         <thead>
@@ -137,7 +137,10 @@ pub fn StreetView() -> impl IntoView {
                                             {COLUMNS
                                                 .iter()
                                                 .map(|(key, _)| {
-                                                    let cell = row.cell(key);
+                                                    let cell = match row.cell(key) {
+                                                        c if c.is_empty() => "–".to_string(),
+                                                        c => c,
+                                                    };
                                                     let cls = match *key {
                                                         "state" => class,
                                                         "address" | "firmware" => "hex",
@@ -162,7 +165,9 @@ pub fn StreetView() -> impl IntoView {
                         </p>
                     </Show>
                 </div>
-                <LampPanel focus=focus/>
+                <Show when=move || focus.with(|f| f.is_some())>
+                    <LampPanel focus=focus/>
+                </Show>
             </div>
         </div>
     }
@@ -287,12 +292,12 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
                     <button on:click=move |_| street.alerts.set(Default::default())>"Clear"</button>
                 </div>
                 <ul>
-                    {move || street.alerts.get().into_iter().take(8).map(|a| {
-                        let address = a.address;
+                    {move || street.alerts.get().into_iter().take(8).map(|r| {
+                        let address = r.alert.address;
                         view! {
                             <li>
-                                <a href="#street" on:click=move |_| focus.set(Some(address))>{a.address.to_string()}</a>
-                                {format!(" {} ({})", a.what, super::seconds(a.at))}
+                                <a href="#street" on:click=move |_| focus.set(Some(address))>{address.to_string()}</a>
+                                {format!(" {} (at {})", r.alert.what, r.wall)}
                             </li>
                         }
                     }).collect_view()}
@@ -374,7 +379,7 @@ fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     view! {
         <aside class="details lamp" id="lamp-panel">
             {move || match lamp.get() {
-                None => view! { <p class="muted">"Click a lamp to see its page."</p> }.into_any(),
+                None => view! { <p class="muted">"This lamp is not on the street any more."</p> }.into_any(),
                 Some(l) => {
                     let series = |f: fn(&crate::street::Sample) -> Option<f64>| {
                         let pts: Vec<(u64, f64)> = l.history.iter().filter_map(|s| f(s).map(|v| (s.at, v))).collect();
@@ -386,10 +391,17 @@ fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         ("SNR dB", series(|s| s.snr.map(f64::from))),
                     ];
                     view! {
-                        <h3>{format!("Lamp {}", l.address)}</h3>
-                        <p>
-                            {l.state().map(|s| s.to_string()).unwrap_or_else(|| "not read yet".into())}
-                            {l.unreachable.clone().map(|u| format!(" — unreachable: {u}"))}
+                        <div class="lamp-head">
+                            <h3>{format!("Lamp {}", l.address)}</h3>
+                            <button id="lamp-close" title="close this lamp's page" on:click=move |_| focus.set(None)>"✕"</button>
+                        </div>
+                        <p class:problem=l.in_trouble()>
+                            {match (&l.unreachable, l.state()) {
+                                (Some(u), Some(s)) => format!("Unreachable: {u}. Last read: {s}."),
+                                (Some(u), None) => format!("Unreachable: {u}."),
+                                (None, Some(s)) => format!("Lamp {s}"),
+                                (None, None) => "Not read yet.".to_string(),
+                            }}
                         </p>
                         {plots.into_iter().map(|(name, (line, range))| view! {
                             <figure class="spark">

@@ -20,8 +20,9 @@ use super::service::{Discovered, Service};
 use crate::time::{Duration, Instant, MS};
 use alloc::collections::BTreeMap;
 
-/// Time after a round's window for the last answers to arrive.
-pub const ROUND_MARGIN: Duration = 1_500 * MS;
+/// Time after a round's window for the last answers to arrive (an
+/// answer and its ACK take about 0.1 s on the line at B-PSK).
+pub const ROUND_MARGIN: Duration = 1_000 * MS;
 
 /// A discovery in progress.
 #[derive(Debug, Clone)]
@@ -55,9 +56,10 @@ impl Discovery {
         (d, r)
     }
 
-    /// A window long enough for `boards` answers (1-60 s).
+    /// A window long enough for `boards` answers (1-60 s): 0.1 s each,
+    /// so that an answer and its ACK rarely meet another.
     pub fn window_for(boards: usize) -> u8 {
-        (boards / 10 + 2).min(60) as u8
+        (boards / 10 + 1).min(60) as u8
     }
 
     fn next_round(&mut self, now: Instant) -> Request {
