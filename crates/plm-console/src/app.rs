@@ -100,6 +100,10 @@ pub fn App() -> impl IntoView {
     if let Some(p) = query("profile").and_then(|k| Profile::from_key(&k)) {
         console.profile.set(p);
     }
+    // `?lamps=500`: a longer simulated street (demos, `cargo xtask bench`).
+    if let Some(n) = query("lamps").and_then(|n| n.parse::<usize>().ok()) {
+        console.sim.lamps.set(n.clamp(1, crate::stores::MAX_LAMPS));
+    }
     console.connect_simulated();
     crate::bench_hook::install(console);
     if let Ok(handle) = set_interval_with_handle(move || console.tick(), TICK) {

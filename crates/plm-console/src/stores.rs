@@ -70,6 +70,8 @@ pub struct ModemStore {
 pub struct SimStore {
     /// Modems on the simulated line (1 = alone).
     pub nodes: RwSignal<usize>,
+    /// Lamps on the simulated street.
+    pub lamps: RwSignal<usize>,
     /// Whether the simulated cable is plugged in.
     pub plugged: RwSignal<bool>,
     /// Frames echoed by the peers.
@@ -80,6 +82,8 @@ pub struct SimStore {
 
 /// Lamps on the simulated street the page opens on.
 pub const STREET_LAMPS: usize = 12;
+/// The longest simulated street.
+pub const MAX_LAMPS: usize = 500;
 /// Alerts kept, newest first.
 pub const ALERTS: usize = 200;
 
@@ -197,6 +201,7 @@ pub fn provide_console() -> Console {
         },
         sim: SimStore {
             nodes: RwSignal::new(1),
+            lamps: RwSignal::new(STREET_LAMPS),
             plugged: RwSignal::new(true),
             echoed: RwSignal::new(0),
             line_events: RwSignal::new(VecDeque::new()),
@@ -256,7 +261,7 @@ impl Console {
         let baud = self.conn.baud.get_untracked();
         let t: Box<dyn Transport> = if profile.is_street() {
             Box::new(SimTransport::street(
-                STREET_LAMPS,
+                self.sim.lamps.get_untracked(),
                 profile.attach(),
                 baud,
                 SIM_SEED,

@@ -53,11 +53,55 @@ pub fn SimulatorView() -> impl IntoView {
     view! {
         <div class="cards">
             <TopologyCard/>
+            <StreetCard/>
             <ModemFaultsCard/>
             <LineCard/>
             <UartCard/>
             <LineEventsCard/>
         </div>
+    }
+}
+
+/// The simulated street: how many lamps (a restart of the street).
+#[component]
+fn StreetCard() -> impl IntoView {
+    let c = use_console();
+    let choice = RwSignal::new(c.sim.lamps.get_untracked());
+    view! {
+        <article class="card" id="sim-street">
+            <h3>"Street"</h3>
+            <p class="muted">
+                "Street-light controller boards along the line behind the concentrator (node 0), on the three mains phases in turn. Each lamp can be broken, repaired or cut off from its own page (Street view)."
+            </p>
+            <label>
+                "Lamps "
+                <select
+                    id="sim-lamps"
+                    on:change=move |ev| {
+                        if let Ok(n) = event_target_value(&ev).parse() {
+                            choice.set(n);
+                        }
+                    }
+                >
+                    {[6usize, 12, 50, 100, 500]
+                        .into_iter()
+                        .map(|n| view! {
+                            <option value=n.to_string() selected=move || choice.get() == n>{n.to_string()}</option>
+                        })
+                        .collect_view()}
+                </select>
+            </label>
+            <button id="sim-apply-street" on:click=move |_| {
+                c.sim.lamps.set(choice.get_untracked());
+                if c.profile.get_untracked().is_street() {
+                    c.connect_simulated();
+                } else {
+                    c.set_profile(crate::profile::Profile::StreetBoard);
+                }
+            }>
+                "Restart the street"
+            </button>
+        </article>
     }
 }
 

@@ -214,6 +214,38 @@ fn dimming_value(text: &str) -> Result<u8, String> {
     })
 }
 
+/// Eight checkboxes, IO7 first, bound to the bits of `mask`.
+fn pin_boxes(mask: RwSignal<u8>, id: &'static str) -> impl IntoView {
+    (0..8u8)
+        .rev()
+        .map(|bit| {
+            view! {
+                <input
+                    type="checkbox"
+                    id=format!("{id}-{bit}")
+                    title=format!("IO{bit}")
+                    prop:checked=move || mask.get() & (1 << bit) != 0
+                    on:change=move |ev| {
+                        let on = event_target_checked(&ev);
+                        mask.update(|m| if on { *m |= 1 << bit } else { *m &= !(1 << bit) });
+                    }
+                />
+            }
+        })
+        .collect_view()
+}
+
+/// The output levels to send: a level on a pin configured as an input
+/// is refused (STEVAL UM 4.6.4: bit x = 1 -> IOx output), with the pin.
+fn output_levels(config: u8, levels: u8) -> Result<u8, String> {
+    match (0..8).find(|b| levels & !config & (1 << b) != 0) {
+        Some(b) => Err(format!(
+            "nothing sent: IO{b} is an input; configure it as an output (and Set) before driving it"
+        )),
+        None => Ok(levels),
+    }
+}
+
 /// The computer's clock, local time.
 fn computer_clock() -> Clock {
     let d = js_sys::Date::new_0();
@@ -277,6 +309,25 @@ fn GroupActions(
             <button id="street-clock-all" on:click=set_clocks title="sets every lamp's clock to this computer's local time">
                 "Set all clocks from this computer"
             </button>
+            <button
+                id="street-clock-selected"
+                prop:disabled=move || selected.with(|s| s.is_empty())
+                on:click=move |_| {
+                    let c = computer_clock();
+                    let list: Vec<Address> = selected.get_untracked().into_iter().collect();
+                    let r = street.act(|s| {
+                        list.iter().try_for_each(|a| {
+                            s.request(Request::to(*a, Message::Service(Service::ClockSet(c))), Box::new(|_| {}))
+                        })
+                    });
+                    message.set(Some(match r {
+                        Ok(()) => format!("clock {c} sent to {} lamp(s)", list.len()),
+                        Err(e) => format!("nothing sent: {e}"),
+                    }));
+                }
+            >
+                "Set clocks of selected"
+            </button>
         </div>
     }
 }
@@ -339,6 +390,10 @@ fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
             .get()
             .and_then(|a| street.with_fleet(|f| f.get(&a).cloned()))
     });
+    let io_config = RwSignal::new(0u8);
+    let outputs = RwSignal::new(0u8);
+    let group = RwSignal::new(2u8);
+    let params = RwSignal::new(String::new());
     let ask = move |m: Message, what: &'static str| {
         let Some(a) = focus.get_untracked() else {
             return;
@@ -351,7 +406,15 @@ fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                     note.set(Some(match r {
                         Ok(Message::Service(Service::ClockNow(c))) => format!("clock: {c}"),
                         Ok(Message::Service(Service::Inputs(v))) => {
-                            format!("GPIO inputs: {v:08b} (IO7…IO0)")
+                            format!("GPIO levels: {v:08b} (IO7…IO0)")
+                        }
+                        Ok(Message::Service(Service::IoConfig(v))) => {
+                            io_config.set(v);
+                            format!("GPIO outputs: {v:08b} (IO7…IO0, 1 = output)")
+                        }
+                        Ok(Message::Service(Service::Params { group, data })) => {
+                            params.set(plm_core::hex::encode(&data));
+                            format!("parameter group {group}: {} bytes read", data.len())
                         }
                         Ok(Message::Error(e)) => format!("{what}: the board answered {e}"),
                         Ok(_) => format!("{what}: done"),
@@ -426,9 +489,43 @@ fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         <div class="form-row">
                             <button on:click=move |_| ask(Message::Service(Service::ClockGet), "clock")>"Read clock"</button>
                             <button on:click=move |_| ask(Message::Service(Service::ClockSet(computer_clock())), "set clock")>"Set clock from this computer"</button>
-                            <button on:click=move |_| ask(Message::Service(Service::InputsGet), "GPIO")>"Read GPIO"</button>
+                            <button on:click=move |_| ask(Message::Service(Service::InputsGet), "GPIO")>"Read GPIO levels"</button>
                             <button on:click=move |_| ask(Message::Hid(plm_core::app::Hid::Reset(plm_core::app::hid::RESET_SOFTWARE)), "ballast reset")>"Reset ballast"</button>
                         </div>
+                        <h4>"GPIO (IO7 … IO0)"</h4>
+                        <div class="form-row pins">
+                            <span class="muted">"output"</span>
+                            {pin_boxes(io_config, "io-config")}
+                            <button on:click=move |_| ask(Message::Service(Service::IoConfigGet), "read GPIO configuration")>"Read"</button>
+                            <button id="lamp-io-config" on:click=move |_| ask(Message::Service(Service::IoConfigSet(io_config.get_untracked())), "set GPIO configuration")>"Set"</button>
+                        </div>
+                        <div class="form-row pins">
+                            <span class="muted">"level"</span>
+                            {pin_boxes(outputs, "io-out")}
+                            <button id="lamp-io-out" on:click=move |_| {
+                                match output_levels(io_config.get_untracked(), outputs.get_untracked()) {
+                                    Ok(v) => ask(Message::Service(Service::OutputsSet(v)), "set GPIO outputs"),
+                                    Err(e) => note.set(Some(e)),
+                                }
+                            }>"Set outputs"</button>
+                        </div>
+                        <h4>"Parameters"</h4>
+                        <div class="form-row">
+                            <select on:change=move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2))>
+                                {plm_core::app::service::PROG_GROUPS.iter().enumerate().map(|(i, n)| view! {
+                                    <option value=i.to_string() selected=i == 2>{*n}</option>
+                                }).collect_view()}
+                            </select>
+                            <button on:click=move |_| ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters")>"Read"</button>
+                            <button id="lamp-params-write" on:click=move |_| {
+                                let data = match plm_core::hex::parse(&params.get_untracked()) {
+                                    Ok(d) => d,
+                                    Err(e) => return note.set(Some(format!("nothing sent: {e}"))),
+                                };
+                                ask(Message::Service(Service::ParamSet { group: group.get_untracked(), data }), "write parameters")
+                            }>"Write"</button>
+                        </div>
+                        <input id="lamp-params" class="payload hex" placeholder="32 bytes, hex" prop:value=move || params.get() on:input=move |ev| params.set(event_target_value(&ev))/>
                         <Show when=move || street.port.get().contains("simulated")>
                             <div class="form-row sim-actions">
                                 <span class="muted">"Simulator:"</span>
@@ -443,5 +540,26 @@ fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                 }
             }}
         </aside>
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_only_on_output_pins() {
+        assert_eq!(output_levels(0b1111_0000, 0b0101_0000), Ok(0b0101_0000));
+        assert!(output_levels(0b1111_0000, 0b0000_1000)
+            .unwrap_err()
+            .contains("IO3 is an input"));
+    }
+
+    #[test]
+    fn dimming_values_must_be_numbers() {
+        assert_eq!(dimming_value(" 40 "), Ok(40));
+        assert!(dimming_value("4o")
+            .unwrap_err()
+            .contains("not a dimming value"));
     }
 }
