@@ -10,6 +10,9 @@
 //   limit, computed from the bytes one exchange puts on the wire as the
 //   console's own traffic log shows them.
 // - gzip -9 sizes of the wasm, JS and CSS in dist/.
+// - The Street view's frame time with a simulated street of 500 lamps
+//   (`?lamps=500`): requestAnimationFrame intervals while the console
+//   discovers and sweeps the street, against a 60 fps frame (16.7 ms).
 //
 // The page is driven through `window.plmBench` (crates/plm-console/src/
 // bench_hook.rs), so the figures are the session's, not a script's clicks.
@@ -28,6 +31,12 @@ const BAUD = 57_600;
 const BITS_PER_BYTE = 10;
 /** MIB object read: 0Ah, firmware version (UM0932 4.2.10). */
 const MIB_INDEX = 0x0a;
+/** Lamps of the simulated street whose Street view is timed. */
+const STREET_LAMPS = 500;
+/** How long its frames are recorded. */
+const STREET_MEASURE_MS = 20_000;
+/** One frame at 60 fps. */
+const FRAME_MS = 1000 / 60;
 
 
 const kib = (n) => `${(n / 1024).toFixed(1)} KiB`;
@@ -73,6 +82,44 @@ async function exchange(page) {
   return parts;
 }
 
+/** Frame times of the Street view on a 500-lamp street. */
+async function streetFrames(browser, base) {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  const errors = pageErrors(page);
+  await page.goto(base + `?lamps=${STREET_LAMPS}#street`);
+  await page.locator('#fleet-table').waitFor();
+  // Let discovery fill the table, then measure while the sweep runs.
+  await page.waitForFunction(
+    (n) => document.querySelectorAll('#fleet-table tbody tr').length >= n,
+    Math.round(STREET_LAMPS * 0.8),
+    { timeout: 240_000, polling: 1000 },
+  );
+  const frames = await page.evaluate(
+    (ms) =>
+      new Promise((resolve) => {
+        const out = [];
+        let last = performance.now();
+        const end = last + ms;
+        const step = (t) => {
+          out.push(t - last);
+          last = t;
+          if (t < end) requestAnimationFrame(step);
+          else resolve(out);
+        };
+        requestAnimationFrame(step);
+      }),
+    STREET_MEASURE_MS,
+  );
+  const rows = await page.locator('#fleet-table tbody tr').count();
+  const progress = await page.textContent('#street-progress');
+  await page.screenshot({ path: path.join(artifacts, 'bench-street-500.png') });
+  await page.close();
+  if (errors.length) throw new Error(`errors in the street page: ${errors.join('; ')}`);
+  frames.sort((a, b) => a - b);
+  const at = (p) => frames[Math.min(frames.length - 1, Math.ceil((frames.length * p) / 100) - 1)];
+  return { rows, progress, n: frames.length, p50: at(50), p99: at(99), max: frames[frames.length - 1] };
+}
+
 async function main() {
   const { server, base } = await serveDist();
   const browser = await launchChromium();
@@ -103,6 +150,7 @@ async function main() {
     const parts = await exchange(page);
     await page.screenshot({ path: path.join(artifacts, 'bench-diagnostics.png') });
     if (errors.length) throw new Error(`errors in the page: ${errors.join('; ')}`);
+    const street = await streetFrames(browser, base);
 
     const bytes = parts.reduce((n, p) => n + p.bytes, 0);
     const wireMs = (bytes * BITS_PER_BYTE * 1000) / BAUD;
@@ -130,6 +178,9 @@ async function main() {
       `  chained  ${READS} in ${msText(chained.elapsedMs)} = ${rate(chained).toFixed(0)} /s (${pct(rate(chained))}; the next sent from the reply, as a view does)`,
       `  wire-time limit: ${parts.map((p) => `${p.name} ${p.bytes}`).join(' + ')} = ${bytes} bytes`,
       `    x ${BITS_PER_BYTE} bits / ${BAUD} baud = ${wireMs.toFixed(2)} ms -> ${limit.toFixed(0)} round trips /s`,
+      '',
+      `Street view, ${street.rows} of ${STREET_LAMPS} lamps in the table (${street.progress}), ${street.n} frames over ${STREET_MEASURE_MS / 1000} s:`,
+      `  frame time p50 ${msText(street.p50)} (ratio ${(street.p50 / FRAME_MS).toFixed(2)} of a 60 fps frame)   p99 ${msText(street.p99)} (ratio ${(street.p99 / FRAME_MS).toFixed(2)})   max ${msText(street.max)}`,
       '',
       'Size, gzip -9:',
       ...dsizes.map((r) => `  ${r.file.padEnd(40)} ${kib(r.raw).padStart(10)} -> ${kib(r.gz).padStart(9)}`),
