@@ -65,7 +65,8 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
-            name: "console in Chromium: ACK latency, MIB-read rate, Street view with 500 lamps, size",
+            name:
+                "console in Chromium: ACK latency, MIB-read rate, Street view with 500 lamps, size",
             sources: &["tests/e2e/bench.mjs"],
             cmd: Cmd::new("node").args(["tests/e2e/bench.mjs"]),
             needs_dist: true,

@@ -576,9 +576,10 @@ mod tests {
     use plm_sim::Attach;
 
     const S: Duration = 1_000 * MS;
+    const LAMPS: usize = 50;
 
     fn session(via: Attach) -> StreetSession {
-        let t = Box::new(SimTransport::street(12, via, 57_600, 3));
+        let t = Box::new(SimTransport::street(LAMPS, via, 57_600, 3));
         let conc = match via {
             Attach::Board => Concentrator::usart(RequesterConfig::default()),
             Attach::Modem => Concentrator::modem(
@@ -591,24 +592,31 @@ mod tests {
         StreetSession::new(t, conc)
     }
 
+    /// Runs `d` of the street's time; calls the replies, as the console
+    /// does, and returns the alerts.
     fn run(s: &mut StreetSession, d: Duration) -> Vec<Alert> {
         let start = s.now();
         s.run_until(start, start + d);
-        s.take().alerts
+        let tick = s.take();
+        for (reply, r) in tick.replies {
+            reply(r);
+        }
+        tick.alerts
     }
 
-    /// Discovery, the sweep reading every lamp, dimming one and all, a
-    /// failed lamp and an unreachable one raised as alerts: through the
-    /// board's USART and through a bare modem.
+    /// A street of 50: discovery, the sweep reading every lamp, dimming
+    /// one and all (broadcast), every clock set, a failed lamp and an
+    /// unreachable one raised as alerts: through the board's USART and
+    /// through a bare modem.
     #[test]
     fn a_street_is_found_read_dimmed_and_watched() {
         for via in [Attach::Board, Attach::Modem] {
             let mut s = session(via);
             s.discover();
-            run(&mut s, 60 * S);
-            assert_eq!(s.fleet().len(), 12, "{via:?}: every lamp found");
+            run(&mut s, 90 * S);
+            assert_eq!(s.fleet().len(), LAMPS, "{via:?}: every lamp found");
             assert!(s.sweep().on, "a street just found is swept");
-            run(&mut s, 30 * S);
+            run(&mut s, 60 * S);
             for lamp in s.fleet().values() {
                 assert_eq!(
                     lamp.state(),
@@ -631,8 +639,33 @@ mod tests {
 
             assert!(s.dim(None, 101).is_err(), "refused before anything is sent");
             s.dim(None, 60).unwrap();
-            run(&mut s, 40 * S);
+            run(&mut s, 60 * S);
             assert!(s.fleet().values().all(|l| l.dimming == Some(60)));
+            let full = s.fleet()[&street_address(40)].ballast.unwrap().lamp_power;
+            assert_eq!(full, 120, "{via:?}: 150 W × (0.5 + 0.5 × 60 %)");
+
+            let noon = Clock {
+                hours: 12,
+                minutes: 0,
+                seconds: 0,
+            };
+            let set = Request::all(Message::Service(Service::ClockSet(noon)));
+            s.request(set, Box::new(|_| {})).unwrap();
+            run(&mut s, 2 * S);
+            let clock = std::rc::Rc::new(std::cell::Cell::new(None));
+            let got = clock.clone();
+            let get = Request::to(street_address(LAMPS), Message::Service(Service::ClockGet));
+            s.request(get, Box::new(move |r| got.set(Some(r)))).unwrap();
+            run(&mut s, 10 * S);
+            match clock.take() {
+                Some(Ok(Message::Service(Service::ClockNow(c)))) => {
+                    assert!(
+                        c.seconds_of_day().abs_diff(noon.seconds_of_day()) < 20,
+                        "{via:?}: {c}"
+                    )
+                }
+                other => panic!("{via:?}: {other:?}"),
+            }
 
             let t = s.transport_mut().unwrap().simulator().unwrap();
             t.lamp(5, LampAction::Fail);

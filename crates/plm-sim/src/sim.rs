@@ -336,10 +336,16 @@ impl Sim {
                         // Each board's RTC drifted up to 10 minutes; each
                         // ballast has its own stream of chance.
                         let offset = rng.below(600);
-                        let ballast = BallastConfig {
+                        let mut ballast = BallastConfig {
                             seed: rng.next_u64(),
                             ..config.ballast.clone()
                         };
+                        // A street at work has lamps of every age: up to
+                        // two years of nights, a start about each night.
+                        if ballast.warm_start {
+                            ballast.lifetime_hours = rng.below(8_000) as u16;
+                            ballast.power_ons = ballast.lifetime_hours / 11 + 1;
+                        }
                         Host::Board(Box::new(board(Some(ballast), offset)))
                     }
                 };
