@@ -8,8 +8,10 @@
 //! 3. the concentrator acknowledges each answer with an APP_ACK_FRAME
 //!    `[01h, 0Bh]`: that board stays quiet for the rest of the session;
 //! 4. after the window, a round that found someone new is followed by
-//!    another (the answers that collided come again); a round that found
-//!    nobody ends the discovery.
+//!    another (the answers that collided come again), with a window sized
+//!    for twice as many boards as that round found (fewer are left each
+//!    time, and a window too short would hide them all in collisions);
+//!    a round that found nobody ends the discovery.
 //!
 //! Sans-IO: the caller sends the requests and frames it is given.
 
@@ -96,6 +98,7 @@ impl Discovery {
             return None;
         }
         if self.new_in_round > 0 && self.round < self.max_rounds {
+            self.window = self.window.min(Discovery::window_for(2 * self.new_in_round));
             return Some(self.next_round(now));
         }
         self.done = true;
