@@ -9,41 +9,10 @@ use plm_core::app::{Address, ErrorCode, LineFrame, Message};
 use plm_core::link::Dialect;
 use plm_core::st7580::{Command, DataRequest, TxParams};
 use serde_json::{json, Value};
-use std::io::Write;
-use std::process::{Command as Process, Output, Stdio};
+mod common;
+use common::{decode, plm};
 
 const BOARD: Address = Address([0x00, 0x80, 0xE1, 0x00, 0x00, 0x2A]);
-
-/// Runs `plm` with `args`, feeding `stdin` when given.
-fn plm(args: &[&str], stdin: Option<&str>) -> Output {
-    let mut child = Process::new(env!("CARGO_BIN_EXE_plm"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("plm runs");
-    {
-        let mut input = child.stdin.take().unwrap();
-        if let Some(text) = stdin {
-            input.write_all(text.as_bytes()).unwrap();
-        }
-    }
-    child.wait_with_output().unwrap()
-}
-
-/// The JSON lines of a successful run.
-fn decode(args: &[&str], stdin: Option<&str>) -> Vec<Value> {
-    let out = plm(args, stdin);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "plm {args:?} failed: {stderr}");
-    assert!(stderr.is_empty(), "unexpected stderr: {stderr}");
-    String::from_utf8(out.stdout)
-        .expect("UTF-8 output")
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON ({e}): {l}")))
-        .collect()
-}
 
 fn board(hex: &str) -> Vec<Value> {
     decode(&["decode", "--board", hex], None)

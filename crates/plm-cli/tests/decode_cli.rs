@@ -7,39 +7,8 @@ use plm_core::st7580::{
     IndicationInfo, Modulation, ResetCause, ResetData, Temperature, TxParams,
 };
 use serde_json::{json, Map, Value};
-use std::io::Write;
-use std::process::{Command as Process, Output, Stdio};
-
-/// Runs `plm` with `args`, feeding `stdin` when given.
-fn plm(args: &[&str], stdin: Option<&str>) -> Output {
-    let mut child = Process::new(env!("CARGO_BIN_EXE_plm"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("plm runs");
-    {
-        let mut input = child.stdin.take().unwrap();
-        if let Some(text) = stdin {
-            input.write_all(text.as_bytes()).unwrap();
-        }
-    }
-    child.wait_with_output().unwrap()
-}
-
-/// The JSON lines of a successful run.
-fn decode(args: &[&str], stdin: Option<&str>) -> Vec<Value> {
-    let out = plm(args, stdin);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "plm {args:?} failed: {stderr}");
-    assert!(stderr.is_empty(), "unexpected stderr: {stderr}");
-    String::from_utf8(out.stdout)
-        .expect("UTF-8 output")
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON ({e}): {l}")))
-        .collect()
-}
+mod common;
+use common::{decode, plm};
 
 fn decode_st7580(hex: &str) -> Vec<Value> {
     decode(&["decode", "--chip", "st7580", hex], None)

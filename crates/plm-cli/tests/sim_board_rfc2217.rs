@@ -137,11 +137,7 @@ impl Driver {
         // The requester gives up by itself after its attempts (1.5 s, then
         // 3 s, then 4.5 s by default): this limit only guards the test.
         self.run_until(Duration::from_secs(20), |h| match h {
-            Happening::App(
-                e @ (AppEvent::Answered { id: i, .. }
-                | AppEvent::Failed { id: i, .. }
-                | AppEvent::Sent { id: i }),
-            ) if *i == id => {
+            Happening::App(e) if e.fate_of() == Some(id) => {
                 fate = Some(e.clone());
                 true
             }

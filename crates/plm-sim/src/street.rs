@@ -117,11 +117,7 @@ impl StreetDriver {
         let id = self.submit(request);
         let mut fate = None;
         self.run_until(limit, |h| match h {
-            Happening::App(
-                e @ (AppEvent::Answered { id: i, .. }
-                | AppEvent::Failed { id: i, .. }
-                | AppEvent::Sent { id: i }),
-            ) if *i == id => {
+            Happening::App(e) if e.fate_of() == Some(id) => {
                 fate = Some(e.clone());
                 true
             }

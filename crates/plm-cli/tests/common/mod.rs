@@ -1,7 +1,7 @@
-//! What the `plm sim` tests share: the real binary started on a free
-//! loopback port, and a minimal RFC 2217 client written here,
-//! independently of the server's codec, so that a codec bug cannot cancel
-//! itself out.
+//! What the `plm` tests share: the real binary run with arguments and
+//! standard input (`plm decode`), or started on a free loopback port
+//! (`plm sim`) with a minimal RFC 2217 client written here, independently
+//! of the server's codec, so that a codec bug cannot cancel itself out.
 //!
 //! Timeouts are generous (seconds) so that a loaded machine does not make
 //! a test flaky.
@@ -309,4 +309,35 @@ impl Link {
             self.telnet
         );
     }
+}
+
+/// Runs `plm` with `args`, feeding `stdin` when given.
+pub fn plm(args: &[&str], stdin: Option<&str>) -> std::process::Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_plm"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("plm runs");
+    {
+        let mut input = child.stdin.take().unwrap();
+        if let Some(text) = stdin {
+            input.write_all(text.as_bytes()).unwrap();
+        }
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// The JSON lines of a successful `plm` run.
+pub fn decode(args: &[&str], stdin: Option<&str>) -> Vec<serde_json::Value> {
+    let out = plm(args, stdin);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "plm {args:?} failed: {stderr}");
+    assert!(stderr.is_empty(), "unexpected stderr: {stderr}");
+    String::from_utf8(out.stdout)
+        .expect("UTF-8 output")
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON ({e}): {l}")))
+        .collect()
 }

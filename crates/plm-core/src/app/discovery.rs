@@ -98,7 +98,9 @@ impl Discovery {
             return None;
         }
         if self.new_in_round > 0 && self.round < self.max_rounds {
-            self.window = self.window.min(Discovery::window_for(2 * self.new_in_round));
+            self.window = self
+                .window
+                .min(Discovery::window_for(2 * self.new_in_round));
             return Some(self.next_round(now));
         }
         self.done = true;

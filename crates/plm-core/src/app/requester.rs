@@ -155,6 +155,19 @@ pub enum AppEvent {
     },
 }
 
+impl AppEvent {
+    /// The request this event ends (answered, failed, or sent when no
+    /// answer is expected); `None` for the others.
+    pub fn fate_of(&self) -> Option<RequestId> {
+        match self {
+            AppEvent::Answered { id, .. } | AppEvent::Failed { id, .. } | AppEvent::Sent { id } => {
+                Some(*id)
+            }
+            _ => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 struct InFlight {
     id: RequestId,
