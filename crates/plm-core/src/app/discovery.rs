@@ -7,11 +7,10 @@
 //!    random moment within the window (so that answers rarely collide);
 //! 3. the concentrator acknowledges each answer with an APP_ACK_FRAME
 //!    `[01h, 0Bh]`: that board stays quiet for the rest of the session;
-//! 4. after the window, a round that found someone new is followed by
-//!    another (the answers that collided come again), with a window sized
-//!    for twice as many boards as that round found (fewer are left each
-//!    time, and a window too short would hide them all in collisions);
-//!    a round that found nobody ends the discovery.
+//! 4. after the window, a round that heard any answer is followed by
+//!    another (the answers that collided, and the boards whose ACK was
+//!    lost, come again); [`Discovery::next_window`] sizes it and says
+//!    when silence means the street has answered.
 //!
 //! Sans-IO: the caller sends the requests and frames it is given.
 
@@ -21,6 +20,10 @@ use super::requester::Request;
 use super::service::{Discovered, Service};
 use crate::time::{Duration, Instant, MS};
 use alloc::collections::BTreeMap;
+
+/// Answers a second of window holds with few collisions: an answer and
+/// its ACK take about 0.1 s on the line at B-PSK.
+pub const BOARDS_PER_SECOND: usize = 10;
 
 /// Time after a round's window for the last answers to arrive (an
 /// answer and its ACK take about 0.1 s on the line at B-PSK).
@@ -34,7 +37,9 @@ pub struct Discovery {
     max_rounds: u8,
     round: u8,
     round_ends: Instant,
-    new_in_round: usize,
+    heard_in_round: usize,
+    /// The last round heard a quarter of what its window holds.
+    crowded: bool,
     found: BTreeMap<Address, Discovered>,
     done: bool,
 }
@@ -50,7 +55,8 @@ impl Discovery {
             max_rounds: max_rounds.max(1),
             round: 0,
             round_ends: 0,
-            new_in_round: 0,
+            heard_in_round: 0,
+            crowded: false,
             found: BTreeMap::new(),
             done: false,
         };
@@ -61,12 +67,39 @@ impl Discovery {
     /// A window long enough for `boards` answers (1-60 s): 0.1 s each,
     /// so that an answer and its ACK rarely meet another.
     pub fn window_for(boards: usize) -> u8 {
-        (boards / 10 + 1).min(60) as u8
+        (boards / BOARDS_PER_SECOND + 1).min(60) as u8
+    }
+
+    /// What follows a round of `window` seconds that heard `heard`
+    /// answers: the next round's window, or `None` to stop. In a crowd
+    /// most answers collide unheard, so a crowded window can hear little
+    /// or nothing even when many boards are left:
+    /// - a round that heard a quarter of what its window holds was
+    ///   crowded: the window doubles;
+    /// - a silent round ends the discovery, unless nobody was ever heard
+    ///   or the round before was crowded: then the window doubles (up to
+    ///   60 s, after which silence is taken as nobody there);
+    /// - otherwise the window stays (shrinking it on a count collisions
+    ///   may have cut would hide the boards still silent).
+    pub fn next_window(
+        window: u8,
+        heard: usize,
+        was_crowded: bool,
+        ever_heard: bool,
+    ) -> Option<u8> {
+        let holds = window as usize * BOARDS_PER_SECOND;
+        let double = (window < 60).then(|| window.saturating_mul(2).min(60));
+        match heard {
+            0 if was_crowded || !ever_heard => double,
+            0 => None,
+            h if 4 * h >= holds => double.or(Some(60)),
+            _ => Some(window),
+        }
     }
 
     fn next_round(&mut self, now: Instant) -> Request {
         self.round += 1;
-        self.new_in_round = 0;
+        self.heard_in_round = 0;
         self.round_ends = now + self.window as u64 * 1_000 * MS + ROUND_MARGIN;
         Request::all(Message::Service(Service::Discover {
             session: self.session,
@@ -80,9 +113,8 @@ impl Discovery {
         let Message::Service(Service::DiscoverReply(d)) = message else {
             return None;
         };
-        if self.found.insert(address, *d).is_none() {
-            self.new_in_round += 1;
-        }
+        self.found.insert(address, *d);
+        self.heard_in_round += 1;
         Some(message.ack().to(address))
     }
 
@@ -97,10 +129,16 @@ impl Discovery {
         if self.done || now < self.round_ends {
             return None;
         }
-        if self.new_in_round > 0 && self.round < self.max_rounds {
-            self.window = self
-                .window
-                .min(Discovery::window_for(2 * self.new_in_round));
+        let holds = self.window as usize * BOARDS_PER_SECOND;
+        let next = Discovery::next_window(
+            self.window,
+            self.heard_in_round,
+            self.crowded,
+            !self.found.is_empty(),
+        );
+        self.crowded = 4 * self.heard_in_round >= holds;
+        if let (Some(w), true) = (next, self.round < self.max_rounds) {
+            self.window = w;
             return Some(self.next_round(now));
         }
         self.done = true;
@@ -120,5 +158,24 @@ impl Discovery {
     /// The boards found, by address.
     pub fn found(&self) -> &BTreeMap<Address, Discovered> {
         &self.found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crowded_rounds_widen_and_silence_ends_only_after_a_quiet_round() {
+        // 2 s hold 20 answers: 5 heard is a crowd, 4 is not.
+        assert_eq!(Discovery::next_window(2, 5, false, true), Some(4));
+        assert_eq!(Discovery::next_window(2, 4, false, true), Some(2));
+        // Silence after a quiet round: done; after a crowd, or before
+        // anybody was heard: look again with a wider window.
+        assert_eq!(Discovery::next_window(8, 0, false, true), None);
+        assert_eq!(Discovery::next_window(8, 0, true, true), Some(16));
+        assert_eq!(Discovery::next_window(8, 0, false, false), Some(16));
+        assert_eq!(Discovery::next_window(60, 0, true, false), None);
+        assert_eq!(Discovery::next_window(60, 400, true, true), Some(60));
     }
 }
