@@ -92,7 +92,7 @@ async function streetFrames(browser, base) {
   await page.waitForFunction(
     (n) => document.querySelectorAll('#fleet-table tbody tr').length >= n,
     Math.round(STREET_LAMPS * 0.8),
-    { timeout: 240_000, polling: 1000 },
+    { timeout: 900_000, polling: 1000 },
   );
   const frames = await page.evaluate(
     (ms) =>
