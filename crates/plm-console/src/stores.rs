@@ -375,20 +375,11 @@ impl Console {
 
     /// Does something to the simulated world, if that is what is connected.
     pub fn with_simulator(&self, f: impl FnOnce(&mut dyn Simulator)) {
-        {
-            let session = self.session();
-            let street = self.street.session();
-            let mut s = session.borrow_mut();
-            let mut st = street.borrow_mut();
-            let t = if self.profile.get_untracked().is_street() {
-                st.transport_mut()
-            } else {
-                s.transport_mut()
-            };
+        self.with_active(|t, _| {
             if let Some(sim) = t.and_then(|t| t.simulator()) {
                 f(sim);
             }
-        }
+        });
         self.refresh();
     }
 
@@ -408,53 +399,48 @@ impl Console {
 
     /// Applies what happened without letting time pass.
     fn refresh(&self) {
-        let (tick, state, kind, port) = {
-            let session = self.session();
-            let mut s = session.borrow_mut();
-            let tick = s.take();
-            let street = self.street.session();
-            let mut st = street.borrow_mut();
-            let t = if self.profile.get_untracked().is_street() {
-                st.transport_mut().map(|t| &*t)
-            } else {
-                s.transport()
-            };
+        let tick = self.session().borrow_mut().take();
+        let street = self.street.session().borrow_mut().take();
+        let (state, kind, port) = self.with_active(|t, state| {
             let (kind, port) = t.map_or((String::new(), String::new()), |t| {
                 (t.kind().into(), t.port())
             });
-            let state = if self.profile.get_untracked().is_street() {
-                st.state()
-            } else {
-                s.state()
-            };
-            let street_tick = st.take();
-            drop(st);
-            self.apply_street(street_tick);
-            (tick, state, kind, port)
-        };
+            (state, kind, port)
+        });
         set_if_changed(self.conn.state, state);
         set_if_changed(self.conn.kind, kind);
         set_if_changed(self.conn.port, port);
         self.apply(tick);
+        self.apply_street(street);
         self.refresh_sim();
     }
 
-    fn refresh_sim(&self) {
-        let (events, echoed, plugged, state) = {
-            let session = self.session();
+    /// Calls `f` with the transport of the profile in use (the street
+    /// session's or the modem session's) and its state; no session is
+    /// borrowed once it returns.
+    fn with_active<R>(
+        &self,
+        f: impl FnOnce(Option<&mut (dyn Transport + 'static)>, LinkState) -> R,
+    ) -> R {
+        if self.profile.get_untracked().is_street() {
             let street = self.street.session();
+            let mut s = street.borrow_mut();
+            let state = s.state();
+            f(s.transport_mut(), state)
+        } else {
+            let session = self.session();
             let mut s = session.borrow_mut();
-            let mut st = street.borrow_mut();
-            let (state, t) = if self.profile.get_untracked().is_street() {
-                (st.state(), st.transport_mut())
-            } else {
-                (s.state(), s.transport_mut())
-            };
-            match t.and_then(|t| t.simulator()) {
+            let state = s.state();
+            f(s.transport_mut(), state)
+        }
+    }
+
+    fn refresh_sim(&self) {
+        let (events, echoed, plugged, state) =
+            self.with_active(|t, state| match t.and_then(|t| t.simulator()) {
                 Some(sim) => (sim.line_events(), sim.echoed(), sim.plugged(), Some(state)),
                 None => (Vec::new(), 0, true, None),
-            }
-        };
+            });
         if let Some(state) = state {
             set_if_changed(self.conn.state, state);
         }

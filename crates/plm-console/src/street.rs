@@ -221,7 +221,8 @@ impl StreetSession {
         let now = self.now();
         self.session_no = self.session_no.wrapping_add(1);
         let expected = self.fleet.len().max(12);
-        let (d, first) = Discovery::start(now, self.session_no, Discovery::window_for(expected), 8);
+        let (d, first) =
+            Discovery::start(now, self.session_no, Discovery::window_for(expected), 40);
         self.discovery = Some(d);
         self.conc.submit(now, first);
         self.flush();
@@ -460,7 +461,7 @@ impl StreetSession {
                 ..
             } => {
                 let purpose = self.purposes.remove(&id);
-                self.answered(now, address, &answer);
+                self.answered(now, address);
                 if let Some(p) = purpose {
                     self.fulfil(now, p, Ok(answer));
                 }
@@ -488,7 +489,7 @@ impl StreetSession {
     }
 
     /// Any answer shows the lamp is there.
-    fn answered(&mut self, now: Instant, address: Address, _answer: &Message) {
+    fn answered(&mut self, now: Instant, address: Address) {
         let lamp = self.lamp(address);
         lamp.last_seen = Some(now);
         if lamp.unreachable.take().is_some() {

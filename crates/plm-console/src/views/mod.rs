@@ -6,6 +6,7 @@ pub mod connection_bar;
 pub mod data;
 pub mod diagnostics;
 pub mod files;
+pub mod lamp;
 pub mod modem;
 pub mod serial_port;
 pub mod simulator;

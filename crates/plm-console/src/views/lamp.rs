@@ -1,0 +1,241 @@
+//! A lamp's own page in the Street view: its history plotted (power,
+//! temperature, SNR), read now, dimming, clock, GPIO, parameter groups,
+//! ballast reset, and on a simulated street the faults a demo needs.
+
+use super::street::{computer_clock, dimming_value};
+use crate::stores::use_console;
+use crate::transport::LampAction;
+use leptos::prelude::*;
+use plm_core::app::service::Service;
+use plm_core::app::{Address, Message, Request};
+
+/// Eight checkboxes, IO7 first, bound to the bits of `mask`.
+fn pin_boxes(mask: RwSignal<u8>, id: &'static str) -> impl IntoView {
+    (0..8u8)
+        .rev()
+        .map(|bit| {
+            view! {
+                <input
+                    type="checkbox"
+                    id=format!("{id}-{bit}")
+                    title=format!("IO{bit}")
+                    prop:checked=move || mask.get() & (1 << bit) != 0
+                    on:change=move |ev| {
+                        let on = event_target_checked(&ev);
+                        mask.update(|m| if on { *m |= 1 << bit } else { *m &= !(1 << bit) });
+                    }
+                />
+            }
+        })
+        .collect_view()
+}
+
+/// The output levels to send: a level on a pin configured as an input
+/// is refused (STEVAL UM 4.6.4: bit x = 1 -> IOx output), with the pin.
+fn output_levels(config: u8, levels: u8) -> Result<u8, String> {
+    match (0..8).find(|b| levels & !config & (1 << b) != 0) {
+        Some(b) => Err(format!(
+            "nothing sent: IO{b} is an input; configure it as an output (and Set) before driving it"
+        )),
+        None => Ok(levels),
+    }
+}
+
+/// One series of a lamp's history as an SVG polyline in a 300 × 60 box.
+fn sparkline(points: &[(u64, f64)]) -> (String, String) {
+    let (Some(first), Some(last)) = (points.first(), points.last()) else {
+        return (String::new(), String::new());
+    };
+    let span = (last.0 - first.0).max(1) as f64;
+    let lo = points.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    let hi = points.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+    let range = (hi - lo).max(1.0);
+    let line = points
+        .iter()
+        .map(|(t, v)| {
+            let x = (t - first.0) as f64 / span * 300.0;
+            let y = 56.0 - (v - lo) / range * 52.0;
+            format!("{x:.1},{y:.1}")
+        })
+        .collect::<Vec<_>>()
+        .join(" ");
+    (line, format!("{lo:.0}…{hi:.0}"))
+}
+
+/// The page of the lamp `focus` names.
+#[component]
+pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
+    let street = use_console().street;
+    let note = RwSignal::new(None::<String>);
+    let level = RwSignal::new(String::from("50"));
+    let lamp = Memo::new(move |_| {
+        street.version.track();
+        focus
+            .get()
+            .and_then(|a| street.with_fleet(|f| f.get(&a).cloned()))
+    });
+    let io_config = RwSignal::new(0u8);
+    let outputs = RwSignal::new(0u8);
+    let group = RwSignal::new(2u8);
+    let params = RwSignal::new(String::new());
+    let ask = move |m: Message, what: &'static str| {
+        let Some(a) = focus.get_untracked() else {
+            return;
+        };
+        note.set(Some(format!("{what}…")));
+        let r = street.act(|s| {
+            s.request(
+                Request::to(a, m),
+                Box::new(move |r| {
+                    note.set(Some(match r {
+                        Ok(Message::Service(Service::ClockNow(c))) => format!("clock: {c}"),
+                        Ok(Message::Service(Service::Inputs(v))) => {
+                            format!("GPIO levels: {v:08b} (IO7…IO0)")
+                        }
+                        Ok(Message::Service(Service::IoConfig(v))) => {
+                            io_config.set(v);
+                            format!("GPIO outputs: {v:08b} (IO7…IO0, 1 = output)")
+                        }
+                        Ok(Message::Service(Service::Params { group, data })) => {
+                            params.set(plm_core::hex::encode(&data));
+                            format!("parameter group {group}: {} bytes read", data.len())
+                        }
+                        Ok(Message::Error(e)) => format!("{what}: the board answered {e}"),
+                        Ok(_) => format!("{what}: done"),
+                        Err(e) => format!("{what}: {e}"),
+                    }))
+                }),
+            )
+        });
+        if let Err(e) = r {
+            note.set(Some(format!("nothing sent: {e}")));
+        }
+    };
+    let sim = move |action: LampAction| {
+        let Some(a) = focus.get_untracked() else {
+            return;
+        };
+        let node = (a.to_u64() - plm_sim::board::ADDRESS_BASE) as usize;
+        street.act(|s| {
+            if let Some(sim) = s.transport_mut().and_then(|t| t.simulator()) {
+                sim.lamp(node, action);
+            }
+        });
+        note.set(Some(format!("simulator: {action:?} on this lamp")));
+    };
+    view! {
+        <aside class="details lamp" id="lamp-panel">
+            {move || match lamp.get() {
+                None => view! { <p class="muted">"This lamp is not on the street any more."</p> }.into_any(),
+                Some(l) => {
+                    let series = |f: fn(&crate::street::Sample) -> Option<f64>| {
+                        let pts: Vec<(u64, f64)> = l.history.iter().filter_map(|s| f(s).map(|v| (s.at, v))).collect();
+                        sparkline(&pts)
+                    };
+                    let plots = [
+                        ("Power W", series(|s| Some(s.power as f64))),
+                        ("Temperature °C", series(|s| Some(s.temperature as f64))),
+                        ("SNR dB", series(|s| s.snr.map(f64::from))),
+                    ];
+                    view! {
+                        <div class="lamp-head">
+                            <h3>{format!("Lamp {}", l.address)}</h3>
+                            <button id="lamp-close" title="close this lamp's page" on:click=move |_| focus.set(None)>"✕"</button>
+                        </div>
+                        <p class:problem=l.in_trouble()>
+                            {match (&l.unreachable, l.state()) {
+                                (Some(u), Some(s)) => format!("Unreachable: {u}. Last read: {s}."),
+                                (Some(u), None) => format!("Unreachable: {u}."),
+                                (None, Some(s)) => format!("Lamp {s}"),
+                                (None, None) => "Not read yet.".to_string(),
+                            }}
+                        </p>
+                        {plots.into_iter().map(|(name, (line, range))| view! {
+                            <figure class="spark">
+                                <figcaption>{format!("{name} {range}")}</figcaption>
+                                <svg viewBox="0 0 300 60" preserveAspectRatio="none"><polyline points=line/></svg>
+                            </figure>
+                        }).collect_view()}
+                        <div class="form-row">
+                            <button id="lamp-read" on:click=move |_| ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read")>"Read now"</button>
+                            <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                            <button id="lamp-dim" on:click=move |_| {
+                                match dimming_value(&level.get_untracked()) {
+                                    Ok(v) => {
+                                        let a = focus.get_untracked();
+                                        let r = street.act(|s| s.dim(a, v));
+                                        note.set(Some(match r { Ok(()) => format!("dimming {v} % sent"), Err(e) => format!("nothing sent: {e}") }));
+                                    }
+                                    Err(e) => note.set(Some(e)),
+                                }
+                            }>"Dim"</button>
+                        </div>
+                        <div class="form-row">
+                            <button on:click=move |_| ask(Message::Service(Service::ClockGet), "clock")>"Read clock"</button>
+                            <button on:click=move |_| ask(Message::Service(Service::ClockSet(computer_clock())), "set clock")>"Set clock from this computer"</button>
+                            <button on:click=move |_| ask(Message::Service(Service::InputsGet), "GPIO")>"Read GPIO levels"</button>
+                            <button on:click=move |_| ask(Message::Hid(plm_core::app::Hid::Reset(plm_core::app::hid::RESET_SOFTWARE)), "ballast reset")>"Reset ballast"</button>
+                        </div>
+                        <h4>"GPIO (IO7 … IO0)"</h4>
+                        <div class="form-row pins">
+                            <span class="muted">"output"</span>
+                            {pin_boxes(io_config, "io-config")}
+                            <button on:click=move |_| ask(Message::Service(Service::IoConfigGet), "read GPIO configuration")>"Read"</button>
+                            <button id="lamp-io-config" on:click=move |_| ask(Message::Service(Service::IoConfigSet(io_config.get_untracked())), "set GPIO configuration")>"Set"</button>
+                        </div>
+                        <div class="form-row pins">
+                            <span class="muted">"level"</span>
+                            {pin_boxes(outputs, "io-out")}
+                            <button id="lamp-io-out" on:click=move |_| {
+                                match output_levels(io_config.get_untracked(), outputs.get_untracked()) {
+                                    Ok(v) => ask(Message::Service(Service::OutputsSet(v)), "set GPIO outputs"),
+                                    Err(e) => note.set(Some(e)),
+                                }
+                            }>"Set outputs"</button>
+                        </div>
+                        <h4>"Parameters"</h4>
+                        <div class="form-row">
+                            <select on:change=move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2))>
+                                {plm_core::app::service::PROG_GROUPS.iter().enumerate().map(|(i, n)| view! {
+                                    <option value=i.to_string() selected=i == 2>{*n}</option>
+                                }).collect_view()}
+                            </select>
+                            <button on:click=move |_| ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters")>"Read"</button>
+                            <button id="lamp-params-write" on:click=move |_| {
+                                let data = match plm_core::hex::parse(&params.get_untracked()) {
+                                    Ok(d) => d,
+                                    Err(e) => return note.set(Some(format!("nothing sent: {e}"))),
+                                };
+                                ask(Message::Service(Service::ParamSet { group: group.get_untracked(), data }), "write parameters")
+                            }>"Write"</button>
+                        </div>
+                        <input id="lamp-params" class="payload hex" placeholder="32 bytes, hex" prop:value=move || params.get() on:input=move |ev| params.set(event_target_value(&ev))/>
+                        <Show when=move || street.port.get().contains("simulated")>
+                            <div class="form-row sim-actions">
+                                <span class="muted">"Simulator:"</span>
+                                <button id="lamp-sim-fail" on:click=move |_| sim(LampAction::Fail)>"Break lamp"</button>
+                                <button on:click=move |_| sim(LampAction::Repair)>"Replace lamp"</button>
+                                <button id="lamp-sim-cut" on:click=move |_| sim(LampAction::Cut)>"Cut supply"</button>
+                                <button on:click=move |_| sim(LampAction::Join)>"Restore supply"</button>
+                            </div>
+                        </Show>
+                        <p class="muted" id="lamp-note">{move || note.get().unwrap_or_default()}</p>
+                    }.into_any()
+                }
+            }}
+        </aside>
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_only_on_output_pins() {
+        assert_eq!(output_levels(0b1111_0000, 0b0101_0000), Ok(0b0101_0000));
+        assert!(output_levels(0b1111_0000, 0b0000_1000)
+            .unwrap_err()
+            .contains("IO3 is an input"));
+    }
+}
