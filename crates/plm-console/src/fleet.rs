@@ -4,6 +4,7 @@
 
 use crate::street::Lamp;
 use plm_core::app::hid::LampState;
+use plm_core::app::Address;
 use plm_core::time::Instant;
 use serde_json::json;
 
@@ -27,8 +28,8 @@ pub const COLUMNS: &[(&str, &str)] = &[
 /// One lamp as a row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
-    /// 12 hex digits.
-    pub address: String,
+    /// The lamp's board.
+    pub address: Address,
     /// `1.4`, empty when unknown.
     pub firmware: String,
     /// `RUN`, `FAILURE`, `UNREACHABLE`, or empty.
@@ -50,7 +51,7 @@ impl Row {
             (None, None) => String::new(),
         };
         Row {
-            address: lamp.address.to_string(),
+            address: lamp.address,
             firmware: lamp
                 .discovered
                 .map(|d| d.firmware.to_string())
@@ -87,7 +88,7 @@ impl Row {
     /// The cell of column `key` as text (empty when unknown).
     pub fn cell(&self, key: &str) -> String {
         match key {
-            "address" => self.address.clone(),
+            "address" => self.address.to_string(),
             "firmware" => self.firmware.clone(),
             "state" => self.state.clone(),
             k => self.number(k).map(|v| format!("{v}")).unwrap_or_default(),
@@ -99,7 +100,7 @@ impl Row {
     pub fn matches(&self, filter: &str) -> bool {
         let f = filter.trim().to_ascii_lowercase();
         f.is_empty()
-            || self.address.contains(&f)
+            || self.address.to_string().contains(&f)
             || self.state.to_ascii_lowercase().contains(&f)
             || self.firmware.contains(&f)
             || (f == "trouble" && self.trouble)
@@ -110,7 +111,9 @@ impl Row {
 pub fn sort(rows: &mut [Row], key: &str, ascending: bool) {
     rows.sort_by(|a, b| {
         let o = match key {
-            "address" | "firmware" | "state" => a.cell(key).cmp(&b.cell(key)),
+            "address" => a.address.cmp(&b.address),
+            "firmware" => a.firmware.cmp(&b.firmware),
+            "state" => a.state.cmp(&b.state),
             k => match (a.number(k), b.number(k)) {
                 (Some(x), Some(y)) => x.total_cmp(&y),
                 (Some(_), None) => return std::cmp::Ordering::Less,
@@ -144,7 +147,7 @@ pub fn to_json(rows: &[Row]) -> String {
         .iter()
         .map(|r| {
             let mut o = serde_json::Map::new();
-            o.insert("address".into(), json!(r.address));
+            o.insert("address".into(), json!(r.address.to_string()));
             o.insert("firmware".into(), json!(r.firmware));
             o.insert("state".into(), json!(r.state));
             o.insert("trouble".into(), json!(r.trouble));
@@ -171,7 +174,7 @@ pub fn state_class(state: &str) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use plm_core::app::{Address, Ballast};
+    use plm_core::app::Ballast;
 
     fn lamp(n: u64, power: u16, status: u16) -> Lamp {
         Lamp {

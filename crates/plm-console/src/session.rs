@@ -34,6 +34,11 @@ pub const SLICE: Duration = MS;
 /// difference is given up: after the page was busy or hidden the
 /// simulated world slows down rather than fast-forwarding.
 pub const MAX_CATCH_UP: Duration = 100 * MS;
+/// How long one tick may keep the page busy, µs of the page's clock: past
+/// it the transport's time stops short of the page's and catches up at the
+/// next tick, so a simulated world the page cannot run in real time (a long
+/// street during discovery) slows down instead of freezing the page.
+pub const TICK_BUDGET_US: f64 = 12_000.0;
 /// How long after its answer a request repeated for want of an ACK may
 /// still see a second answer.
 pub const DUPLICATE_GRACE: Duration = 200 * MS;
@@ -68,6 +73,34 @@ impl Pacer {
     /// any catch-up limit).
     pub fn page_now(&self) -> Instant {
         self.page_now
+    }
+}
+
+/// When a tick must hand the page back (see [`TICK_BUDGET_US`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Budget {
+    clock: Option<fn() -> f64>,
+    until: f64,
+}
+
+impl Budget {
+    /// No limit: tests, and time that must pass whole.
+    pub const UNLIMITED: Budget = Budget {
+        clock: None,
+        until: f64::INFINITY,
+    };
+
+    /// `us` from now on `clock` (µs).
+    pub fn wall(clock: fn() -> f64, us: f64) -> Budget {
+        Budget {
+            clock: Some(clock),
+            until: clock() + us,
+        }
+    }
+
+    /// Whether the time is up.
+    pub fn spent(&self) -> bool {
+        self.clock.is_some_and(|c| c() > self.until)
     }
 }
 
@@ -370,7 +403,7 @@ impl Session {
     /// (µs, any origin) and returns what happened. While the transport is
     /// down, requests fail at once with its reason instead of waiting for
     /// the link's timeouts.
-    pub fn tick(&mut self, page_us: f64) -> Tick {
+    pub fn tick(&mut self, page_us: f64, budget: Budget) -> Tick {
         if self.outstanding() > 0 {
             if let LinkState::Disconnected(why) = self.state() {
                 self.fail_requests(&why);
@@ -379,7 +412,7 @@ impl Session {
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
             let target = self.pacer.target(page_us, start);
             self.page_now = self.pacer.page_now();
-            self.run_until(start, target);
+            self.run_until(start, target, budget);
         }
         self.take()
     }
@@ -389,9 +422,9 @@ impl Session {
         std::mem::take(&mut self.out)
     }
 
-    fn run_until(&mut self, start: Instant, target: Instant) {
+    fn run_until(&mut self, start: Instant, target: Instant, budget: Budget) {
         let mut t = start;
-        while t < target {
+        while t < target && !budget.spent() {
             let mut next = (t + SLICE).min(target);
             if let Some(d) = self.host.poll_timeout() {
                 if d > t && d < next {
@@ -671,7 +704,7 @@ mod tests {
     fn run(s: &mut Session, page: &mut f64, ms: u32, notes: &mut Vec<Note>) {
         for _ in 0..ms / 4 {
             *page += 4_000.0;
-            let t = s.tick(*page);
+            let t = s.tick(*page, Budget::UNLIMITED);
             notes.extend(t.notes);
             for (r, o) in t.replies {
                 r(o);
@@ -864,7 +897,7 @@ mod tests {
         // A page stalled for 30 ms shows on the page's clock only.
         s.request(Command::PingRequest { data: vec![9] }, reply(&seen));
         page += 30_000.0;
-        let _ = s.tick(page);
+        let _ = s.tick(page, Budget::UNLIMITED);
         let l = s.ack_latency();
         assert_eq!(l.count, 3);
         assert!(l.link.max <= SLICE, "{l:?}");
@@ -895,8 +928,8 @@ mod tests {
     #[test]
     fn a_stalled_page_slows_the_simulation_instead_of_racing_it() {
         let mut s = session(1);
-        s.tick(0.0);
-        s.tick(5_000_000.0);
+        s.tick(0.0, Budget::UNLIMITED);
+        s.tick(5_000_000.0, Budget::UNLIMITED);
         assert_eq!(s.now(), MAX_CATCH_UP);
     }
 }

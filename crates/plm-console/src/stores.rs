@@ -3,7 +3,7 @@
 //! session's [`Note`]s to them.
 
 use crate::profile::Profile;
-use crate::session::{Note, Outcome, Session, Tick};
+use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
@@ -390,9 +390,10 @@ impl Console {
 
     /// Lets time pass up to the page's clock: called by the page's timer.
     pub fn tick(&self) {
-        let tick = self.session().borrow_mut().tick(page_now_us());
+        let budget = || Budget::wall(page_now_us, TICK_BUDGET_US);
+        let tick = self.session().borrow_mut().tick(page_now_us(), budget());
         self.apply(tick);
-        let street = self.street.session().borrow_mut().tick(page_now_us());
+        let street = self.street.session().borrow_mut().tick(page_now_us(), budget());
         self.apply_street(street);
         self.refresh_sim();
     }

@@ -6,7 +6,7 @@
 //! Like [`crate::session`], it has no browser in it: time comes in as an
 //! argument, so its tests run natively against a simulated street.
 
-use crate::session::Pacer;
+use crate::session::{Budget, Pacer};
 use crate::transport::{LinkState, Transport};
 use plm_core::app::hid::{self, Hid, LampState};
 use plm_core::app::service::{Clock, Discovered, Service};
@@ -295,7 +295,7 @@ impl StreetSession {
     }
 
     /// Lets the transport's time catch up with the page's clock.
-    pub fn tick(&mut self, page_us: f64) -> StreetTick {
+    pub fn tick(&mut self, page_us: f64, budget: Budget) -> StreetTick {
         if let LinkState::Disconnected(why) = self.state() {
             if self.conc.requester().pending() > 0 {
                 self.conc.abort_all(&why);
@@ -304,15 +304,19 @@ impl StreetSession {
         }
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
             let target = self.pacer.target(page_us, start);
-            self.run_until(start, target);
+            self.run_within(start, target, budget);
         }
         self.take()
     }
 
     /// Runs the street as fast as possible up to `target` (tests).
     pub fn run_until(&mut self, start: Instant, target: Instant) {
+        self.run_within(start, target, Budget::UNLIMITED);
+    }
+
+    fn run_within(&mut self, start: Instant, target: Instant, budget: Budget) {
         let mut t = start;
-        while t < target {
+        while t < target && !budget.spent() {
             let mut next = (t + crate::session::SLICE).min(target);
             for d in [
                 self.conc.poll_timeout(),

@@ -3,6 +3,7 @@
 //! ballast reset, and on a simulated street the faults a demo needs.
 
 use super::street::{computer_clock, dimming_value};
+use super::widgets::button;
 use crate::stores::use_console;
 use crate::transport::LampAction;
 use leptos::prelude::*;
@@ -140,7 +141,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                     view! {
                         <div class="lamp-head">
                             <h3>{format!("Lamp {}", l.address)}</h3>
-                            <button id="lamp-close" title="close this lamp's page" on:click=move |_| focus.set(None)>"✕"</button>
+                            {button("lamp-close", "✕", "close this lamp's page", move || focus.set(None))}
                         </div>
                         <p class:problem=l.in_trouble()>
                             {match (&l.unreachable, l.state()) {
@@ -157,7 +158,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             </figure>
                         }).collect_view()}
                         <div class="form-row">
-                            <button id="lamp-read" on:click=move |_| ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read")>"Read now"</button>
+                            {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
                             <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
                             <button id="lamp-dim" on:click=move |_| {
                                 match dimming_value(&level.get_untracked()) {
@@ -171,17 +172,17 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             }>"Dim"</button>
                         </div>
                         <div class="form-row">
-                            <button on:click=move |_| ask(Message::Service(Service::ClockGet), "clock")>"Read clock"</button>
-                            <button on:click=move |_| ask(Message::Service(Service::ClockSet(computer_clock())), "set clock")>"Set clock from this computer"</button>
-                            <button on:click=move |_| ask(Message::Service(Service::InputsGet), "GPIO")>"Read GPIO levels"</button>
-                            <button on:click=move |_| ask(Message::Hid(plm_core::app::Hid::Reset(plm_core::app::hid::RESET_SOFTWARE)), "ballast reset")>"Reset ballast"</button>
+                            {button("", "Read clock", "", move || ask(Message::Service(Service::ClockGet), "clock"))}
+                            {button("", "Set clock from this computer", "", move || ask(Message::Service(Service::ClockSet(computer_clock())), "set clock"))}
+                            {button("", "Read GPIO levels", "", move || ask(Message::Service(Service::InputsGet), "GPIO"))}
+                            {button("", "Reset ballast", "", move || ask(Message::Hid(plm_core::app::Hid::Reset(plm_core::app::hid::RESET_SOFTWARE)), "ballast reset"))}
                         </div>
                         <h4>"GPIO (IO7 … IO0)"</h4>
                         <div class="form-row pins">
                             <span class="muted">"output"</span>
                             {pin_boxes(io_config, "io-config")}
-                            <button on:click=move |_| ask(Message::Service(Service::IoConfigGet), "read GPIO configuration")>"Read"</button>
-                            <button id="lamp-io-config" on:click=move |_| ask(Message::Service(Service::IoConfigSet(io_config.get_untracked())), "set GPIO configuration")>"Set"</button>
+                            {button("", "Read", "", move || ask(Message::Service(Service::IoConfigGet), "read GPIO configuration"))}
+                            {button("lamp-io-config", "Set", "", move || ask(Message::Service(Service::IoConfigSet(io_config.get_untracked())), "set GPIO configuration"))}
                         </div>
                         <div class="form-row pins">
                             <span class="muted">"level"</span>
@@ -200,7 +201,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                     <option value=i.to_string() selected=i == 2>{*n}</option>
                                 }).collect_view()}
                             </select>
-                            <button on:click=move |_| ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters")>"Read"</button>
+                            {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters"))}
                             <button id="lamp-params-write" on:click=move |_| {
                                 let data = match plm_core::hex::parse(&params.get_untracked()) {
                                     Ok(d) => d,
@@ -213,10 +214,10 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         <Show when=move || street.port.get().contains("simulated")>
                             <div class="form-row sim-actions">
                                 <span class="muted">"Simulator:"</span>
-                                <button id="lamp-sim-fail" on:click=move |_| sim(LampAction::Fail)>"Break lamp"</button>
-                                <button on:click=move |_| sim(LampAction::Repair)>"Replace lamp"</button>
-                                <button id="lamp-sim-cut" on:click=move |_| sim(LampAction::Cut)>"Cut supply"</button>
-                                <button on:click=move |_| sim(LampAction::Join)>"Restore supply"</button>
+                                {button("lamp-sim-fail", "Break lamp", "", move || sim(LampAction::Fail))}
+                                {button("", "Replace lamp", "", move || sim(LampAction::Repair))}
+                                {button("lamp-sim-cut", "Cut supply", "", move || sim(LampAction::Cut))}
+                                {button("", "Restore supply", "", move || sim(LampAction::Join))}
                             </div>
                         </Show>
                         <p class="muted" id="lamp-note">{move || note.get().unwrap_or_default()}</p>

@@ -13,6 +13,7 @@ pub mod simulator;
 pub mod snr_plot;
 pub mod street;
 pub mod traffic;
+pub mod widgets;
 
 use plm_core::time::Instant;
 
@@ -24,6 +25,30 @@ pub fn seconds(at: Instant) -> String {
 /// A duration as milliseconds (`3.2 ms`).
 pub fn millis(us: u64) -> String {
     format!("{:.1} ms", us as f64 / 1_000.0)
+}
+
+/// A decimal number typed in a form (`-12`, `3.5`, `+0.25`; at most 9
+/// digits after the point), or `None`. Written out because std's `f64`
+/// parser brings a 10 KiB table of powers of five into the console's wasm,
+/// and a form needs none of its range.
+pub fn decimal(text: &str) -> Option<f64> {
+    let t = text.trim();
+    let (negative, t) = match t.as_bytes().first()? {
+        b'-' => (true, &t[1..]),
+        b'+' => (false, &t[1..]),
+        _ => (false, t),
+    };
+    let (whole, fraction) = t.split_once('.').unwrap_or((t, ""));
+    let digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
+    if whole.len() + fraction.len() == 0 || whole.len() > 9 || fraction.len() > 9 {
+        return None;
+    }
+    if !digits(whole) || !digits(fraction) {
+        return None;
+    }
+    let number = |s: &str| s.bytes().fold(0u64, |n, b| n * 10 + u64::from(b - b'0'));
+    let v = number(whole) as f64 + number(fraction) as f64 / 10f64.powi(fraction.len() as i32);
+    Some(if negative { -v } else { v })
 }
 
 /// Lowercase hex as spaced byte pairs (`02 00 2c`).
@@ -47,5 +72,12 @@ mod tests {
         assert_eq!(seconds(12_000_345), "12.000345 s");
         assert_eq!(millis(3_249), "3.2 ms");
         assert_eq!(spaced("02002c"), "02 00 2c");
+        assert_eq!(decimal(" 42 "), Some(42.0));
+        assert_eq!(decimal("-3.25"), Some(-3.25));
+        assert_eq!(decimal("+.5"), Some(0.5));
+        assert_eq!(decimal("7."), Some(7.0));
+        for bad in ["", "-", ".", "1e3", "4o", "1.2.3", "0x10", "1234567890"] {
+            assert_eq!(decimal(bad), None, "{bad:?}");
+        }
     }
 }

@@ -199,7 +199,7 @@ fn ModemFaultsCard() -> impl IntoView {
 }
 
 fn percent(text: &str) -> Option<f64> {
-    let v: f64 = text.trim().parse().ok()?;
+    let v = super::decimal(text)?;
     (0.0..=100.0).contains(&v).then_some(v / 100.0)
 }
 
@@ -212,8 +212,8 @@ fn LineCard() -> impl IntoView {
     let corruption = RwSignal::new("0".to_string());
     let message = RwSignal::new(None::<String>);
     let apply = move |_| {
-        let noise_dbuv = match noise.get_untracked().trim().parse::<f64>() {
-            Ok(v) if (0.0..=130.0).contains(&v) => v,
+        let noise_dbuv = match super::decimal(&noise.get_untracked()) {
+            Some(v) if (0.0..=130.0).contains(&v) => v,
             _ => {
                 message.set(Some("noise floor: a number of dBµV from 0 to 130".into()));
                 return;

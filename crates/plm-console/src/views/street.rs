@@ -4,12 +4,13 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
+use super::widgets::button;
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::app::service::{Clock, Service};
 use plm_core::app::{Address, Message, Request};
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 
 /// The view.
 #[component]
@@ -20,21 +21,24 @@ pub fn StreetView() -> impl IntoView {
     let selected = RwSignal::new(BTreeSet::<Address>::new());
     let focus = RwSignal::new(None::<Address>);
     let message = RwSignal::new(None::<String>);
+    // The rows shown, sorted and filtered; the table keys its lines by
+    // address and each cell follows its own row, so a reading changes one
+    // cell and a sort moves lines, without rebuilding the table.
     let rows = Memo::new(move |_| {
         street.version.track();
         let now = street.now.get();
-        let mut rows: Vec<(Address, Row)> =
-            street.with_fleet(|f| f.values().map(|l| (l.address, Row::of(l, now))).collect());
+        let mut rows: Vec<Row> = street.with_fleet(|f| f.values().map(|l| Row::of(l, now)).collect());
         let (key, asc) = sort.get();
-        let mut only: Vec<Row> = rows.iter().map(|r| r.1.clone()).collect();
-        fleet::sort(&mut only, key, asc);
-        rows.sort_by_key(|(_, r)| only.iter().position(|o| o.address == r.address));
+        fleet::sort(&mut rows, key, asc);
         let f = filter.get();
-        rows.retain(|(_, r)| r.matches(&f));
+        rows.retain(|r| r.matches(&f));
         rows
     });
+    let by_address = Memo::new(move |_| {
+        rows.with(|rows| rows.iter().map(|r| (r.address, r.clone())).collect::<HashMap<_, _>>())
+    });
     let export = move |json: bool| {
-        let rows: Vec<Row> = rows.get_untracked().into_iter().map(|r| r.1).collect();
+        let rows: Vec<Row> = rows.get_untracked();
         let r = if json {
             download("street.json", "application/json", &fleet::to_json(&rows))
         } else {
@@ -58,8 +62,8 @@ pub fn StreetView() -> impl IntoView {
                     prop:value=move || filter.get()
                     on:input=move |ev| filter.set(event_target_value(&ev))
                 />
-                <button id="street-export-csv" on:click=move |_| export(false)>"Export CSV"</button>
-                <button id="street-export-json" on:click=move |_| export(true)>"Export JSON"</button>
+                {button("street-export-csv", "Export CSV", "", move || export(false))}
+                {button("street-export-json", "Export JSON", "", move || export(true))}
             </div>
             <GroupActions selected=selected message=message/>
             <Show when=move || message.with(|m| m.is_some())>
@@ -79,7 +83,7 @@ pub fn StreetView() -> impl IntoView {
                                         on:change=move |ev| {
                                             let on = event_target_checked(&ev);
                                             selected.set(if on {
-                                                rows.get_untracked().iter().map(|r| r.0).collect()
+                                                rows.get_untracked().iter().map(|r| r.address).collect()
                                             } else {
                                                 BTreeSet::new()
                                             });
@@ -110,14 +114,14 @@ pub fn StreetView() -> impl IntoView {
                         </thead>
                         <tbody>
                             <For
-                                each=move || rows.get()
-                                key=|(a, r)| (*a, r.clone().numbers.iter().map(|n| n.1.map(|v| v.to_bits())).collect::<Vec<_>>(), r.state.clone(), r.firmware.clone())
-                                children=move |(address, row)| {
-                                    let class = fleet::state_class(&row.state);
+                                each=move || rows.with(|r| r.iter().map(|r| r.address).collect::<Vec<_>>())
+                                key=|a| *a
+                                children=move |address| {
+                                    let row = Memo::new(move |_| by_address.with(|m| m.get(&address).cloned()));
                                     view! {
                                         <tr
-                                            data-address=row.address.clone()
-                                            class:trouble=row.trouble
+                                            data-address=address.to_string()
+                                            class:trouble=move || row.with(|r| r.as_ref().is_some_and(|r| r.trouble))
                                             class:selected=move || focus.get() == Some(address)
                                             on:click=move |_| focus.set(Some(address))
                                         >
@@ -136,16 +140,20 @@ pub fn StreetView() -> impl IntoView {
                                             {COLUMNS
                                                 .iter()
                                                 .map(|(key, _)| {
-                                                    let cell = match row.cell(key) {
-                                                        c if c.is_empty() => "–".to_string(),
-                                                        c => c,
-                                                    };
-                                                    let cls = match *key {
-                                                        "state" => class,
+                                                    let key = *key;
+                                                    let cell = Memo::new(move |_| {
+                                                        row.with(|r| r.as_ref().map(|r| r.cell(key)).unwrap_or_default())
+                                                    });
+                                                    let cls = move || match key {
+                                                        "state" => cell.with(|c| fleet::state_class(c)),
                                                         "address" | "firmware" => "hex",
                                                         _ => "num",
                                                     };
-                                                    view! { <td class=cls data-key=*key>{cell}</td> }
+                                                    view! {
+                                                        <td class=cls data-key=key>
+                                                            {move || cell.with(|c| if c.is_empty() { "–".to_string() } else { c.clone() })}
+                                                        </td>
+                                                    }
                                                 })
                                                 .collect_view()}
                                         </tr>
@@ -272,7 +280,7 @@ fn GroupActions(
             >
                 {move || format!("Dim selected ({})", selected.with(|s| s.len()))}
             </button>
-            <button id="street-dim-all" on:click=move |_| dim(None)>"Dim all (broadcast)"</button>
+            {button("street-dim-all", "Dim all (broadcast)", "", move || dim(None))}
             <button id="street-clock-all" on:click=set_clocks title="sets every lamp's clock to this computer's local time">
                 "Set all clocks from this computer"
             </button>
@@ -307,7 +315,7 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
             <div class="alerts" id="street-alerts" role="alert">
                 <div class="alerts-head">
                     <b>{move || format!("{} alert(s)", street.alerts.with(|a| a.len()))}</b>
-                    <button on:click=move |_| street.alerts.set(Default::default())>"Clear"</button>
+                    {button("", "Clear", "", move || street.alerts.set(Default::default()))}
                 </div>
                 <ul>
                     {move || street.alerts.get().into_iter().take(8).map(|r| {

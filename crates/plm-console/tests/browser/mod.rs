@@ -3,7 +3,7 @@
 //! transports run exactly as in the page, in real time.
 
 use js_sys::Promise;
-use plm_console::session::{Note, Outcome, Session};
+use plm_console::session::{Budget, Note, Outcome, Session};
 use plm_console::stores::page_now_us;
 use plm_core::st7580::Command;
 use std::cell::{Cell, RefCell};
@@ -75,7 +75,7 @@ impl Driven {
     /// One tick of the page's timer: time catches up with the page's
     /// clock, the replies are called.
     pub fn tick(&mut self) {
-        let tick = self.session.tick(page_now_us());
+        let tick = self.session.tick(page_now_us(), Budget::UNLIMITED);
         self.notes.extend(tick.notes);
         for (reply, outcome) in tick.replies {
             reply(outcome);

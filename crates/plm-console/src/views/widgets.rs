@@ -1,0 +1,68 @@
+//! Controls every view uses, written once: each is one non-generic
+//! function, so a page of buttons costs one copy of the button's code in
+//! the console's wasm instead of one per button (DESIGN.md, the 350 KiB
+//! budget).
+
+use leptos::prelude::*;
+
+/// A button labelled `label`; `id` and `title` (a tooltip) may be empty.
+pub fn button(
+    id: &'static str,
+    label: &'static str,
+    title: &'static str,
+    on: impl Fn() + 'static,
+) -> AnyView {
+    button_boxed(id, label, title, Box::new(on))
+}
+
+#[inline(never)]
+fn button_boxed(
+    id: &'static str,
+    label: &'static str,
+    title: &'static str,
+    on: Box<dyn Fn()>,
+) -> AnyView {
+    view! {
+        <button
+            id=(!id.is_empty()).then_some(id)
+            title=(!title.is_empty()).then_some(title)
+            on:click=move |_| on()
+        >
+            {label}
+        </button>
+    }
+    .into_any()
+}
+
+/// A text input bound to `value`; `id` and `placeholder` may be empty.
+#[inline(never)]
+pub fn text_input(
+    id: &'static str,
+    class: &'static str,
+    placeholder: &'static str,
+    size: Option<u32>,
+    value: RwSignal<String>,
+) -> AnyView {
+    view! {
+        <input
+            id=(!id.is_empty()).then_some(id)
+            class=(!class.is_empty()).then_some(class)
+            placeholder=(!placeholder.is_empty()).then_some(placeholder)
+            size=size
+            prop:value=move || value.get()
+            on:input=move |ev| value.set(event_target_value(&ev))
+        />
+    }
+    .into_any()
+}
+
+/// A paragraph showing `text`, empty while it is `None`.
+#[inline(never)]
+pub fn note(id: &'static str, class: &'static str, text: RwSignal<Option<String>>) -> AnyView {
+    view! {
+        <p id=(!id.is_empty()).then_some(id) class=class>
+            {move || text.get().unwrap_or_default()}
+        </p>
+    }
+    .into_any()
+}
