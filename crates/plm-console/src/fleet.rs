@@ -37,14 +37,13 @@ pub struct Row {
     /// Whether it needs a technician's eye.
     pub trouble: bool,
     /// Numbers by column key, `None` when unknown.
-    pub numbers: Vec<(&'static str, Option<f64>)>,
+    pub numbers: Vec<(&'static str, Option<i64>)>,
 }
 
 impl Row {
     /// The row of `lamp`; `now` for how long ago it answered.
     pub fn of(lamp: &Lamp, now: Instant) -> Row {
         let b = lamp.ballast;
-        let n = |v: Option<f64>| v;
         let state = match (&lamp.unreachable, lamp.state()) {
             (Some(_), _) => "UNREACHABLE".to_string(),
             (None, Some(s)) => s.name().to_string(),
@@ -59,26 +58,26 @@ impl Row {
             trouble: lamp.in_trouble(),
             state,
             numbers: vec![
-                ("dimming", n(lamp.dimming.map(f64::from))),
-                ("power", b.map(|b| b.lamp_power as f64)),
-                ("bus_voltage", b.map(|b| b.bus_voltage as f64)),
-                ("lamp_voltage", b.map(|b| b.lamp_voltage as f64)),
-                ("supply_voltage", b.map(|b| b.supply_voltage as f64)),
-                ("temperature", b.map(|b| b.temperature as f64)),
-                ("hours", b.map(|b| b.lifetime_hours as f64)),
-                ("power_ons", b.map(|b| b.power_ons as f64)),
-                ("snr", lamp.snr.map(f64::from)),
+                ("dimming", lamp.dimming.map(i64::from)),
+                ("power", b.map(|b| i64::from(b.lamp_power))),
+                ("bus_voltage", b.map(|b| i64::from(b.bus_voltage))),
+                ("lamp_voltage", b.map(|b| i64::from(b.lamp_voltage))),
+                ("supply_voltage", b.map(|b| i64::from(b.supply_voltage))),
+                ("temperature", b.map(|b| i64::from(b.temperature))),
+                ("hours", b.map(|b| i64::from(b.lifetime_hours))),
+                ("power_ons", b.map(|b| i64::from(b.power_ons))),
+                ("snr", lamp.snr.map(i64::from)),
                 (
                     "last_seen",
                     lamp.last_seen
-                        .map(|t| (now.saturating_sub(t) / 1_000_000) as f64),
+                        .map(|t| (now.saturating_sub(t) / 1_000_000) as i64),
                 ),
             ],
         }
     }
 
     /// The number in column `key`.
-    pub fn number(&self, key: &str) -> Option<f64> {
+    pub fn number(&self, key: &str) -> Option<i64> {
         self.numbers
             .iter()
             .find(|(k, _)| *k == key)
@@ -107,25 +106,24 @@ impl Row {
     }
 }
 
-/// Sorts rows by column `key`; unknown values last.
+/// Sorts rows by column `key`, unknown values last, equal values by
+/// address (so the order never depends on where a row was before).
 pub fn sort(rows: &mut [Row], key: &str, ascending: bool) {
-    rows.sort_by(|a, b| {
+    use std::cmp::Ordering;
+    let direction = |o: Ordering| if ascending { o } else { o.reverse() };
+    rows.sort_unstable_by(|a, b| {
         let o = match key {
-            "address" => a.address.cmp(&b.address),
-            "firmware" => a.firmware.cmp(&b.firmware),
-            "state" => a.state.cmp(&b.state),
+            "address" => direction(a.address.cmp(&b.address)),
+            "firmware" => direction(a.firmware.cmp(&b.firmware)),
+            "state" => direction(a.state.cmp(&b.state)),
             k => match (a.number(k), b.number(k)) {
-                (Some(x), Some(y)) => x.total_cmp(&y),
-                (Some(_), None) => return std::cmp::Ordering::Less,
-                (None, Some(_)) => return std::cmp::Ordering::Greater,
-                (None, None) => std::cmp::Ordering::Equal,
+                (Some(x), Some(y)) => direction(x.cmp(&y)),
+                (Some(_), None) => Ordering::Less,
+                (None, Some(_)) => Ordering::Greater,
+                (None, None) => Ordering::Equal,
             },
         };
-        if ascending {
-            o
-        } else {
-            o.reverse()
-        }
+        o.then_with(|| a.address.cmp(&b.address))
     });
 }
 
@@ -217,7 +215,7 @@ mod tests {
             lines[1]
         );
         let json: serde_json::Value = serde_json::from_str(&to_json(&rows)).unwrap();
-        assert_eq!(json[2]["power"], 150.0);
+        assert_eq!(json[2]["power"], 150);
         assert_eq!(json[0]["trouble"], true);
     }
 }

@@ -56,11 +56,11 @@ fn sparkline(points: &[(u64, f64)]) -> (String, String) {
         .map(|(t, v)| {
             let x = (t - first.0) as f64 / span * 300.0;
             let y = 56.0 - (v - lo) / range * 52.0;
-            format!("{x:.1},{y:.1}")
+            format!("{},{}", super::fixed(x, 1), super::fixed(y, 1))
         })
         .collect::<Vec<_>>()
         .join(" ");
-    (line, format!("{lo:.0}…{hi:.0}"))
+    (line, format!("{}…{}", super::fixed(lo, 0), super::fixed(hi, 0)))
 }
 
 /// The page of the lamp `focus` names.

@@ -24,7 +24,25 @@ pub fn seconds(at: Instant) -> String {
 
 /// A duration as milliseconds (`3.2 ms`).
 pub fn millis(us: u64) -> String {
-    format!("{:.1} ms", us as f64 / 1_000.0)
+    format!("{} ms", fixed(us as f64 / 1_000.0, 1))
+}
+
+/// `v` with `decimals` digits after the point (0-6), rounded half away
+/// from zero: `fixed(2.25, 1)` is `2.3`. Written out, like [`decimal`],
+/// because std's exact float formatting costs the console's wasm more
+/// than this does.
+pub fn fixed(v: f64, decimals: u32) -> String {
+    if !v.is_finite() {
+        return "–".to_string();
+    }
+    let scale = 10u64.pow(decimals.min(6));
+    let scaled = (v.abs() * scale as f64).round() as u64;
+    let sign = if v < 0.0 && scaled != 0 { "-" } else { "" };
+    let whole = scaled / scale;
+    match decimals.min(6) {
+        0 => format!("{sign}{whole}"),
+        d => format!("{sign}{whole}.{:0width$}", scaled % scale, width = d as usize),
+    }
 }
 
 /// A decimal number typed in a form (`-12`, `3.5`, `+0.25`; at most 9
@@ -71,6 +89,11 @@ mod tests {
     fn formats() {
         assert_eq!(seconds(12_000_345), "12.000345 s");
         assert_eq!(millis(3_249), "3.2 ms");
+        assert_eq!(fixed(2.25, 1), "2.3");
+        assert_eq!(fixed(-0.04, 1), "0.0");
+        assert_eq!(fixed(-7.5, 0), "-8");
+        assert_eq!(fixed(56.0, 1), "56.0");
+        assert_eq!(fixed(0.125, 2), "0.13");
         assert_eq!(spaced("02002c"), "02 00 2c");
         assert_eq!(decimal(" 42 "), Some(42.0));
         assert_eq!(decimal("-3.25"), Some(-3.25));

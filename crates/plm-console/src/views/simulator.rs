@@ -21,10 +21,10 @@ pub fn describe_line_event(e: &LineEvent) -> String {
             bytes,
             airtime,
         } => format!(
-            "{}  node {from} sends {bytes} bytes, {} at {frequency} Hz, {:.1} ms on the line",
+            "{}  node {from} sends {bytes} bytes, {} at {frequency} Hz, {} on the line",
             seconds(*at),
             MODULATIONS.get(modulation.bits() as usize).unwrap_or(&"?"),
-            *airtime as f64 / 1_000.0
+            super::millis(*airtime)
         ),
         LineEvent::Heard {
             at,
@@ -33,8 +33,9 @@ pub fn describe_line_event(e: &LineEvent) -> String {
             snr_db,
             corrupted,
         } => format!(
-            "{}  node {to} hears node {from}, SNR {snr_db:.1} dB{}",
+            "{}  node {to} hears node {from}, SNR {} dB{}",
             seconds(*at),
+            super::fixed(*snr_db, 1),
             if *corrupted {
                 ", with a corrupted byte"
             } else {
@@ -207,7 +208,7 @@ fn percent(text: &str) -> Option<f64> {
 fn LineCard() -> impl IntoView {
     let c = use_console();
     let defaults = LineConfig::default();
-    let noise = RwSignal::new(defaults.noise_dbuv.to_string());
+    let noise = RwSignal::new(super::fixed(defaults.noise_dbuv, 0));
     let loss = RwSignal::new("0".to_string());
     let corruption = RwSignal::new("0".to_string());
     let message = RwSignal::new(None::<String>);

@@ -179,8 +179,7 @@ pub fn tick_label(value: f64, step: f64) -> String {
     } else {
         (-step.log10() - 1e-9).ceil() as usize
     };
-    // `+ 0.0` turns -0 into 0.
-    format!("{:.*}", decimals, value + 0.0)
+    super::fixed(value, decimals as u32)
 }
 
 /// Maps `axis.lo..=axis.hi` onto `from..=to` (pixels; `to` < `from` flips).
@@ -306,7 +305,7 @@ pub fn layout(points: &[Point]) -> Option<Plot> {
 
 /// A coordinate as attribute text.
 fn n(v: f64) -> String {
-    format!("{v:.1}")
+    super::fixed(v, 1)
 }
 
 /// The drawing: `<svg id="snr-plot">` with one `circle.snr-point` per
@@ -374,7 +373,7 @@ pub fn draw(plot: Plot) -> impl IntoView {
         <svg
             id="snr-plot"
             class="snr-plot"
-            viewBox=format!("0 0 {WIDTH} {HEIGHT}")
+            viewBox=format!("0 0 {} {}", n(WIDTH), n(HEIGHT))
             role="img"
             aria-label="SNR of the received frames over time"
         >
@@ -389,7 +388,7 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 class="snr-title"
                 x=n(16.0)
                 y=n(middle)
-                transform=format!("rotate(-90 16 {middle})")
+                transform=format!("rotate(-90 16 {})", n(middle))
             >
                 "SNR (dB)"
             </text>
