@@ -15,12 +15,11 @@
 //!   the T_ACK in use: `{count, link: {p50, p99, max}, page: {…}, tAck}`.
 
 use crate::session::{Outcome, Spread};
-use crate::stores::{page_now_us, refusal, Console};
-use js_sys::{Function, Object, Promise, Reflect, JSON};
+use crate::stores::{page_now_us, refusal, unexpected, Console};
+use js_sys::{Function, Object, Promise, Reflect};
 use leptos::prelude::GetUntracked;
 use plm_core::st7580::Command;
 use plm_core::time::Duration;
-use serde_json::json;
 use std::cell::RefCell;
 use std::rc::Rc;
 use wasm_bindgen::prelude::*;
@@ -55,22 +54,32 @@ fn ms(us: Duration) -> f64 {
     us as f64 / 1_000.0
 }
 
-fn spread(s: Spread) -> serde_json::Value {
-    json!({ "p50": ms(s.p50), "p99": ms(s.p99), "max": ms(s.max) })
+/// A JS object of `fields` (JS values straight from Rust: no JSON text,
+/// so no float printing in the console's wasm).
+fn object(fields: &[(&str, JsValue)]) -> JsValue {
+    let o = Object::new();
+    for (k, v) in fields {
+        let _ = Reflect::set(&o, &JsValue::from_str(k), v);
+    }
+    o.into()
 }
 
-fn to_js(value: serde_json::Value) -> JsValue {
-    JSON::parse(&value.to_string()).unwrap_or(JsValue::NULL)
+fn spread(s: Spread) -> JsValue {
+    object(&[
+        ("p50", ms(s.p50).into()),
+        ("p99", ms(s.p99).into()),
+        ("max", ms(s.max).into()),
+    ])
 }
 
 fn ack_latency(c: Console) -> JsValue {
     let l = c.ack_latency();
-    to_js(json!({
-        "count": l.count,
-        "link": spread(l.link),
-        "page": spread(l.page),
-        "tAck": ms(c.conn.timeouts.get_untracked().t_ack),
-    }))
+    object(&[
+        ("count", (l.count as f64).into()),
+        ("link", spread(l.link)),
+        ("page", spread(l.page)),
+        ("tAck", ms(c.conn.timeouts.get_untracked().t_ack).into()),
+    ])
 }
 
 /// One run of `mibReads`.
@@ -119,7 +128,7 @@ fn read(c: Console, run: Rc<RefCell<Run>>, index: u8, chained: bool) {
                 } => r.data_len = data.len(),
                 Outcome::Answer { command, .. } => {
                     r.failed += 1;
-                    let why = refusal(&command).unwrap_or_else(|| format!("{command:?}"));
+                    let why = refusal(&command).unwrap_or_else(|| unexpected(&command));
                     r.first_error.get_or_insert(why);
                 }
                 Outcome::Failed(why) => {
@@ -140,12 +149,15 @@ fn read(c: Console, run: Rc<RefCell<Run>>, index: u8, chained: bool) {
 }
 
 fn finish(r: &Run) {
-    let result = json!({
-        "reads": r.done,
-        "failed": r.failed,
-        "firstError": r.first_error,
-        "dataLen": r.data_len,
-        "elapsedMs": (page_now_us() - r.started) / 1_000.0,
-    });
-    let _ = r.resolve.call1(&JsValue::NULL, &to_js(result));
+    let result = object(&[
+        ("reads", r.done.into()),
+        ("failed", r.failed.into()),
+        (
+            "firstError",
+            r.first_error.as_deref().map_or(JsValue::NULL, JsValue::from_str),
+        ),
+        ("dataLen", (r.data_len as f64).into()),
+        ("elapsedMs", ((page_now_us() - r.started) / 1_000.0).into()),
+    ]);
+    let _ = r.resolve.call1(&JsValue::NULL, &result);
 }

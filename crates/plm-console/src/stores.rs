@@ -227,6 +227,14 @@ pub fn use_console() -> Console {
     expect_context::<Console>()
 }
 
+/// An answer that is not the one a request waits for, in words.
+pub fn unexpected(answer: &Command) -> String {
+    match answer.name() {
+        Some(n) => format!("unexpected answer {n}"),
+        None => format!("unexpected answer, code {:02X}h", answer.code()),
+    }
+}
+
 /// What is wrong with an answer, if it is a refusal, in words.
 pub fn refusal(answer: &Command) -> Option<String> {
     let cause = |e: &ErrorCause| match e.name() {

@@ -97,3 +97,15 @@ pub enum LampAction {
     /// Its supply is back.
     Join,
 }
+
+impl LampAction {
+    /// What it does, in words.
+    pub fn label(self) -> &'static str {
+        match self {
+            LampAction::Fail => "lamp broken",
+            LampAction::Repair => "lamp replaced",
+            LampAction::Cut => "supply cut",
+            LampAction::Join => "supply restored",
+        }
+    }
+}

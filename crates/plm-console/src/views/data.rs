@@ -212,7 +212,7 @@ fn DataRequestCard() -> impl IntoView {
                 }
                 Outcome::Answer { command, .. } => {
                     Err(refusal(&command)
-                        .unwrap_or_else(|| format!("unexpected answer {command:?}")))
+                        .unwrap_or_else(|| crate::stores::unexpected(&command)))
                 }
                 Outcome::Failed(why) => Err(why),
             }))

@@ -122,7 +122,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                 sim.lamp(node, action);
             }
         });
-        note.set(Some(format!("simulator: {action:?} on this lamp")));
+        note.set(Some(format!("simulator: {} on this lamp", action.label())));
     };
     view! {
         <aside class="details lamp" id="lamp-panel">

@@ -116,7 +116,15 @@ pub struct Axis {
 
 /// The smallest 1, 2 or 5 × 10ⁿ that is at least `raw` (`raw` > 0).
 pub fn nice_step(raw: f64) -> f64 {
-    let magnitude = 10f64.powf(raw.log10().floor());
+    // The power of ten at or below `raw`, by steps (no libm log and pow in
+    // the console's wasm for this).
+    let mut magnitude = 1.0;
+    while magnitude * 10.0 <= raw {
+        magnitude *= 10.0;
+    }
+    while magnitude > raw {
+        magnitude /= 10.0;
+    }
     let n = raw / magnitude;
     // The epsilon keeps 0.2 / 0.1 from becoming 5 by a rounding error.
     let nice = [1.0, 2.0, 5.0]
@@ -174,11 +182,11 @@ pub fn nice_axis(lo: f64, hi: f64, spec: &Spec) -> Axis {
 
 /// A tick value with as many decimals as its step needs (`2.6`, `20`).
 pub fn tick_label(value: f64, step: f64) -> String {
-    let decimals = if step >= 1.0 {
-        0
-    } else {
-        (-step.log10() - 1e-9).ceil() as usize
-    };
+    let (mut decimals, mut s) = (0, step);
+    while s < 1.0 - 1e-9 && decimals < 6 {
+        s *= 10.0;
+        decimals += 1;
+    }
     super::fixed(value, decimals as u32)
 }
 

@@ -10,7 +10,7 @@ use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::app::service::{Clock, Service};
 use plm_core::app::{Address, Message, Request};
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The view.
 #[component]
@@ -35,7 +35,7 @@ pub fn StreetView() -> impl IntoView {
         rows
     });
     let by_address = Memo::new(move |_| {
-        rows.with(|rows| rows.iter().map(|r| (r.address, r.clone())).collect::<HashMap<_, _>>())
+        rows.with(|rows| rows.iter().map(|r| (r.address, r.clone())).collect::<BTreeMap<_, _>>())
     });
     let export = move |json: bool| {
         let rows: Vec<Row> = rows.get_untracked();
@@ -141,19 +141,16 @@ pub fn StreetView() -> impl IntoView {
                                                 .iter()
                                                 .map(|(key, _)| {
                                                     let key = *key;
-                                                    let cell = Memo::new(move |_| {
-                                                        row.with(|r| r.as_ref().map(|r| r.cell(key)).unwrap_or_default())
+                                                    let cell = move || row.with(|r| match r.as_ref().map(|r| r.cell(key)) {
+                                                        Some(c) if !c.is_empty() => c,
+                                                        _ => "–".to_string(),
                                                     });
                                                     let cls = move || match key {
-                                                        "state" => cell.with(|c| fleet::state_class(c)),
+                                                        "state" => row.with(|r| r.as_ref().map_or("", |r| fleet::state_class(&r.state))),
                                                         "address" | "firmware" => "hex",
                                                         _ => "num",
                                                     };
-                                                    view! {
-                                                        <td class=cls data-key=key>
-                                                            {move || cell.with(|c| if c.is_empty() { "–".to_string() } else { c.clone() })}
-                                                        </td>
-                                                    }
+                                                    view! { <td class=cls data-key=key>{cell}</td> }
                                                 })
                                                 .collect_view()}
                                         </tr>
