@@ -10,7 +10,7 @@ use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::app::service::{Clock, Service};
 use plm_core::app::{Address, Message, Request};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 
 /// The view.
 #[component]
@@ -33,9 +33,6 @@ pub fn StreetView() -> impl IntoView {
         let f = filter.get();
         rows.retain(|r| r.matches(&f));
         rows
-    });
-    let by_address = Memo::new(move |_| {
-        rows.with(|rows| rows.iter().map(|r| (r.address, r.clone())).collect::<BTreeMap<_, _>>())
     });
     let export = move |json: bool| {
         let rows: Vec<Row> = rows.get_untracked();
@@ -117,7 +114,11 @@ pub fn StreetView() -> impl IntoView {
                                 each=move || rows.with(|r| r.iter().map(|r| r.address).collect::<Vec<_>>())
                                 key=|a| *a
                                 children=move |address| {
-                                    let row = Memo::new(move |_| by_address.with(|m| m.get(&address).cloned()));
+                                    let row = Memo::new(move |_| {
+                                        street.version.track();
+                                        let now = street.now.get();
+                                        street.with_fleet(|f| f.get(&address).map(|l| Row::of(l, now)))
+                                    });
                                     view! {
                                         <tr
                                             data-address=address.to_string()
