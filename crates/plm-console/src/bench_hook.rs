@@ -154,7 +154,9 @@ fn finish(r: &Run) {
         ("failed", r.failed.into()),
         (
             "firstError",
-            r.first_error.as_deref().map_or(JsValue::NULL, JsValue::from_str),
+            r.first_error
+                .as_deref()
+                .map_or(JsValue::NULL, JsValue::from_str),
         ),
         ("dataLen", (r.data_len as f64).into()),
         ("elapsedMs", ((page_now_us() - r.started) / 1_000.0).into()),

@@ -401,7 +401,11 @@ impl Console {
         let budget = || Budget::wall(page_now_us, TICK_BUDGET_US);
         let tick = self.session().borrow_mut().tick(page_now_us(), budget());
         self.apply(tick);
-        let street = self.street.session().borrow_mut().tick(page_now_us(), budget());
+        let street = self
+            .street
+            .session()
+            .borrow_mut()
+            .tick(page_now_us(), budget());
         self.apply_street(street);
         self.refresh_sim();
     }

@@ -211,8 +211,7 @@ fn DataRequestCard() -> impl IntoView {
                     ))
                 }
                 Outcome::Answer { command, .. } => {
-                    Err(refusal(&command)
-                        .unwrap_or_else(|| crate::stores::unexpected(&command)))
+                    Err(refusal(&command).unwrap_or_else(|| crate::stores::unexpected(&command)))
                 }
                 Outcome::Failed(why) => Err(why),
             }))

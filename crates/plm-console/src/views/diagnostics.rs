@@ -53,53 +53,53 @@ fn PingCard() -> impl IntoView {
     let payload = RwSignal::new(String::from("50 4c 4d 21"));
     let result = RwSignal::new(None::<Result<String, String>>);
     let history = RwSignal::new(Vec::<u64>::new());
-    let ping =
-        move |_| {
-            let data = match plm_core::hex::parse(&payload.get_untracked()) {
-                Ok(d) if d.len() <= 255 => d,
-                Ok(d) => {
-                    result.set(Some(Err(format!(
-                        "nothing sent: a frame carries at most 255 bytes, not {}",
-                        d.len()
-                    ))));
-                    return;
-                }
-                Err(e) => {
-                    result.set(Some(Err(format!("nothing sent: {e}"))));
-                    return;
-                }
-            };
-            result.set(Some(Ok("sent, waiting for the answer…".into())));
-            let sent = data.clone();
-            c.request(Command::PingRequest { data }, move |o| {
-                result.set(Some(match o {
-                    Outcome::Answer {
-                        command: Command::PingConfirm { data },
-                        rtt,
-                    } => {
-                        history.update(|h| {
-                            h.push(rtt);
-                            if h.len() > 10 {
-                                h.remove(0);
-                            }
-                        });
-                        let same = if data == sent {
-                            "payload echoed intact"
-                        } else {
-                            "payload differs from the one sent!"
-                        };
-                        Ok(format!(
-                            "PingConfirm in {} ({same}): {}",
-                            millis(rtt),
-                            spaced(&plm_core::hex::encode(&data))
-                        ))
-                    }
-                    Outcome::Answer { command, .. } => Err(refusal(&command)
-                        .unwrap_or_else(|| crate::stores::unexpected(&command))),
-                    Outcome::Failed(why) => Err(why),
-                }))
-            });
+    let ping = move |_| {
+        let data = match plm_core::hex::parse(&payload.get_untracked()) {
+            Ok(d) if d.len() <= 255 => d,
+            Ok(d) => {
+                result.set(Some(Err(format!(
+                    "nothing sent: a frame carries at most 255 bytes, not {}",
+                    d.len()
+                ))));
+                return;
+            }
+            Err(e) => {
+                result.set(Some(Err(format!("nothing sent: {e}"))));
+                return;
+            }
         };
+        result.set(Some(Ok("sent, waiting for the answer…".into())));
+        let sent = data.clone();
+        c.request(Command::PingRequest { data }, move |o| {
+            result.set(Some(match o {
+                Outcome::Answer {
+                    command: Command::PingConfirm { data },
+                    rtt,
+                } => {
+                    history.update(|h| {
+                        h.push(rtt);
+                        if h.len() > 10 {
+                            h.remove(0);
+                        }
+                    });
+                    let same = if data == sent {
+                        "payload echoed intact"
+                    } else {
+                        "payload differs from the one sent!"
+                    };
+                    Ok(format!(
+                        "PingConfirm in {} ({same}): {}",
+                        millis(rtt),
+                        spaced(&plm_core::hex::encode(&data))
+                    ))
+                }
+                Outcome::Answer { command, .. } => {
+                    Err(refusal(&command).unwrap_or_else(|| crate::stores::unexpected(&command)))
+                }
+                Outcome::Failed(why) => Err(why),
+            }))
+        });
+    };
     view! {
         <article class="card" id="ping">
             <h3>"Ping"</h3>

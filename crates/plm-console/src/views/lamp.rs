@@ -60,7 +60,10 @@ fn sparkline(points: &[(u64, f64)]) -> (String, String) {
         })
         .collect::<Vec<_>>()
         .join(" ");
-    (line, format!("{}…{}", super::fixed(lo, 0), super::fixed(hi, 0)))
+    (
+        line,
+        format!("{}…{}", super::fixed(lo, 0), super::fixed(hi, 0)),
+    )
 }
 
 /// The page of the lamp `focus` names.

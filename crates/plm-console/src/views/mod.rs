@@ -41,7 +41,11 @@ pub fn fixed(v: f64, decimals: u32) -> String {
     let whole = scaled / scale;
     match decimals.min(6) {
         0 => format!("{sign}{whole}"),
-        d => format!("{sign}{whole}.{:0width$}", scaled % scale, width = d as usize),
+        d => format!(
+            "{sign}{whole}.{:0width$}",
+            scaled % scale,
+            width = d as usize
+        ),
     }
 }
 

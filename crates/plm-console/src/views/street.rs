@@ -27,7 +27,8 @@ pub fn StreetView() -> impl IntoView {
     let rows = Memo::new(move |_| {
         street.version.track();
         let now = street.now.get();
-        let mut rows: Vec<Row> = street.with_fleet(|f| f.values().map(|l| Row::of(l, now)).collect());
+        let mut rows: Vec<Row> =
+            street.with_fleet(|f| f.values().map(|l| Row::of(l, now)).collect());
         let (key, asc) = sort.get();
         fleet::sort(&mut rows, key, asc);
         let f = filter.get();

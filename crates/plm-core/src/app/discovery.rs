@@ -38,6 +38,12 @@ pub struct Discovery {
     round: u8,
     round_ends: Instant,
     heard_in_round: usize,
+    /// This round checks a silence with a wider window.
+    confirming: bool,
+    /// Boards found before this round.
+    found_before: usize,
+    /// New boards the previous round heard, if its window was this one.
+    previous: Option<usize>,
     /// The last round heard a quarter of what its window holds.
     crowded: bool,
     found: BTreeMap<Address, Discovered>,
@@ -56,6 +62,9 @@ impl Discovery {
             round: 0,
             round_ends: 0,
             heard_in_round: 0,
+            confirming: false,
+            found_before: 0,
+            previous: None,
             crowded: false,
             found: BTreeMap::new(),
             done: false,
@@ -70,29 +79,40 @@ impl Discovery {
         (boards / BOARDS_PER_SECOND + 1).min(60) as u8
     }
 
-    /// What follows a round of `window` seconds that heard `heard`
-    /// answers: the next round's window, or `None` to stop. In a crowd
+    /// What follows a round of `window` seconds that heard `heard` new
+    /// boards (`previous`: what the round before heard, if its window was
+    /// the same): the next round's window, or `None` to stop. In a crowd
     /// most answers collide unheard, so a crowded window can hear little
     /// or nothing even when many boards are left:
     /// - a round that heard a quarter of what its window holds was
     ///   crowded: the window doubles;
-    /// - a silent round ends the discovery, unless nobody was ever heard
-    ///   or the round before was crowded: then the window doubles (up to
-    ///   60 s, after which silence is taken as nobody there);
+    /// - a round that heard no fewer than the one before in the same
+    ///   window was crowded too: with few boards left each round hears
+    ///   fewer than the last (those heard are acknowledged and stay
+    ///   quiet), while in a crowd collisions keep the count low and flat;
+    /// - a silent round after a crowded one, or before anybody was heard,
+    ///   doubles the window (up to 60 s, after which silence is taken as
+    ///   nobody there);
+    /// - any other silent round is believed only once a round with twice
+    ///   its window (`confirming`) is silent too: a crowd that collided
+    ///   whole is silent as well, and a wider window breaks it up;
     /// - otherwise the window stays (shrinking it on a count collisions
     ///   may have cut would hide the boards still silent).
     pub fn next_window(
         window: u8,
         heard: usize,
+        previous: Option<usize>,
         was_crowded: bool,
         ever_heard: bool,
+        confirming: bool,
     ) -> Option<u8> {
         let holds = window as usize * BOARDS_PER_SECOND;
         let double = (window < 60).then(|| window.saturating_mul(2).min(60));
         match heard {
-            0 if was_crowded || !ever_heard => double,
+            0 if was_crowded || !ever_heard || !confirming => double,
             0 => None,
             h if 4 * h >= holds => double.or(Some(60)),
+            h if previous.is_some_and(|p| h >= p) => double.or(Some(60)),
             _ => Some(window),
         }
     }
@@ -100,6 +120,7 @@ impl Discovery {
     fn next_round(&mut self, now: Instant) -> Request {
         self.round += 1;
         self.heard_in_round = 0;
+        self.found_before = self.found.len();
         self.round_ends = now + self.window as u64 * 1_000 * MS + ROUND_MARGIN;
         Request::all(Message::Service(Service::Discover {
             session: self.session,
@@ -130,14 +151,19 @@ impl Discovery {
             return None;
         }
         let holds = self.window as usize * BOARDS_PER_SECOND;
+        let heard = self.found.len() - self.found_before;
         let next = Discovery::next_window(
             self.window,
-            self.heard_in_round,
+            heard,
+            self.previous,
             self.crowded,
             !self.found.is_empty(),
+            self.confirming,
         );
-        self.crowded = 4 * self.heard_in_round >= holds;
+        self.confirming = heard == 0 && !self.crowded && !self.found.is_empty();
+        self.crowded = 4 * heard >= holds || self.previous.is_some_and(|p| heard > 0 && heard >= p);
         if let (Some(w), true) = (next, self.round < self.max_rounds) {
+            self.previous = (w == self.window).then_some(heard);
             self.window = w;
             return Some(self.next_round(now));
         }
@@ -168,14 +194,49 @@ mod tests {
     #[test]
     fn crowded_rounds_widen_and_silence_ends_only_after_a_quiet_round() {
         // 2 s hold 20 answers: 5 heard is a crowd, 4 is not.
-        assert_eq!(Discovery::next_window(2, 5, false, true), Some(4));
-        assert_eq!(Discovery::next_window(2, 4, false, true), Some(2));
+        assert_eq!(
+            Discovery::next_window(2, 5, None, false, true, false),
+            Some(4)
+        );
+        assert_eq!(
+            Discovery::next_window(2, 4, None, false, true, false),
+            Some(2)
+        );
+        // Fewer than the round before in the same window: the crowd thins.
+        assert_eq!(
+            Discovery::next_window(4, 3, Some(6), false, true, false),
+            Some(4)
+        );
+        // As many or more: a crowd keeps the count flat.
+        assert_eq!(
+            Discovery::next_window(4, 6, Some(6), false, true, false),
+            Some(8)
+        );
         // Silence after a quiet round: done; after a crowd, or before
         // anybody was heard: look again with a wider window.
-        assert_eq!(Discovery::next_window(8, 0, false, true), None);
-        assert_eq!(Discovery::next_window(8, 0, true, true), Some(16));
-        assert_eq!(Discovery::next_window(8, 0, false, false), Some(16));
-        assert_eq!(Discovery::next_window(60, 0, true, false), None);
-        assert_eq!(Discovery::next_window(60, 400, true, true), Some(60));
+        assert_eq!(
+            Discovery::next_window(8, 0, Some(3), false, true, true),
+            None
+        );
+        assert_eq!(
+            Discovery::next_window(8, 0, Some(3), false, true, false),
+            Some(16)
+        );
+        assert_eq!(
+            Discovery::next_window(8, 0, None, true, true, false),
+            Some(16)
+        );
+        assert_eq!(
+            Discovery::next_window(8, 0, None, false, false, false),
+            Some(16)
+        );
+        assert_eq!(
+            Discovery::next_window(60, 0, None, true, false, false),
+            None
+        );
+        assert_eq!(
+            Discovery::next_window(60, 400, None, true, true, false),
+            Some(60)
+        );
     }
 }
