@@ -75,20 +75,6 @@ fn without_comment_lines(js: &str) -> String {
     out
 }
 
-#[cfg(test)]
-mod tests {
-    use super::without_comment_lines;
-
-    #[test]
-    fn comment_lines_go_code_stays() {
-        let js = "// head\nconst A = 'a//b'; // tail stays\n\n/**\n * doc\n */\nfunction f() {\n  /* one */\n  return /x\\/\\//;\n}\n";
-        assert_eq!(
-            without_comment_lines(js),
-            "const A = 'a//b'; // tail stays\nfunction f() {\n  return /x\\/\\//;\n}\n"
-        );
-    }
-}
-
 /// Trunk, told not to look for its own updates: the machine may have no
 /// network beyond the package registries. The `wasm-opt` that index.html
 /// asks for (`data-wasm-opt`) is npm's `binaryen`, installed by setup with
@@ -111,5 +97,19 @@ fn require_console() -> Result {
         Ok(())
     } else {
         Err("the console is not built yet: index.html is missing (issue 4)".to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::without_comment_lines;
+
+    #[test]
+    fn comment_lines_go_code_stays() {
+        let js = "// head\nconst A = 'a//b'; // tail stays\n\n/**\n * doc\n */\nfunction f() {\n  /* one */\n  return /x\\/\\//;\n}\n";
+        assert_eq!(
+            without_comment_lines(js),
+            "const A = 'a//b'; // tail stays\nfunction f() {\n  return /x\\/\\//;\n}\n"
+        );
     }
 }
