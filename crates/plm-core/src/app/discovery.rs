@@ -160,7 +160,8 @@ impl Discovery {
             !self.found.is_empty(),
             self.confirming,
         );
-        self.confirming = heard == 0 && !self.crowded && !self.found.is_empty();
+        // The next round, twice as wide, checks this silence.
+        self.confirming = heard == 0 && !self.found.is_empty();
         self.crowded = 4 * heard >= holds || self.previous.is_some_and(|p| heard > 0 && heard >= p);
         if let (Some(w), true) = (next, self.round < self.max_rounds) {
             self.previous = (w == self.window).then_some(heard);
