@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot } from './journeys.mjs';
+import { shot, tab } from './journeys.mjs';
 
 let server;
 let base;
@@ -103,6 +103,24 @@ test('a failed lamp and an unreachable one are raised as alerts', async (t) => {
   await page.fill('#street-filter', 'trouble');
   assert.equal(await page.locator('#fleet-table tbody tr').count(), 2);
   await shot(page, 'street-alerts');
+});
+
+test('random lamp failures set in the Simulator view are raised as alerts', async (t) => {
+  const page = await open(t);
+  await tab(page, 'simulator');
+  await page.fill('#sim-failure-rate', 'lots');
+  await page.click('#sim-apply-failures');
+  await page.locator('#sim-failure-note', { hasText: 'nothing changed' }).waitFor();
+  // 60 per lit hour: each of the 12 lamps fails about once a minute.
+  await page.fill('#sim-failure-rate', '60');
+  await page.click('#sim-apply-failures');
+  await page.locator('#sim-failure-note', { hasText: 'about every 1.0 minutes' }).waitFor();
+  await shot(page, 'simulator-failures');
+  await tab(page, 'street');
+  await page
+    .locator('#street-alerts li', { hasText: 'lamp failed' })
+    .first()
+    .waitFor({ timeout: 90_000 });
 });
 
 test('the fleet table exports to CSV', async (t) => {

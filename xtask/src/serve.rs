@@ -42,37 +42,12 @@ pub fn build_dist() -> Result {
     let cmd = trunk().args(["build", "--release", "--dist", "dist"]);
     println!("dist: $ {cmd}");
     cmd.run()?;
-    // Trunk copies the service worker as it is (`copy-file`); its comments
-    // stay in web/sw.js, the copy the browser downloads goes without them
-    // (the console's 350 KiB budget counts every JS file).
-    let sw = root().join("dist/sw.js");
-    let text = std::fs::read_to_string(&sw).map_err(|e| format!("dist/sw.js: {e}"))?;
-    std::fs::write(&sw, without_comment_lines(&text)).map_err(|e| format!("dist/sw.js: {e}"))
-}
-
-/// JavaScript without its whole-line comments (`// …` lines and `/** … */`
-/// blocks that start a line) and blank lines; code lines are kept as they
-/// are, so a `//` inside a string or a regular expression is never touched.
-fn without_comment_lines(js: &str) -> String {
-    let mut out = String::with_capacity(js.len());
-    let mut in_block = false;
-    for line in js.lines() {
-        let t = line.trim_start();
-        if in_block {
-            in_block = !t.contains("*/");
-            continue;
-        }
-        if t.starts_with("/*") {
-            in_block = !t.contains("*/");
-            continue;
-        }
-        if t.is_empty() || t.starts_with("//") {
-            continue;
-        }
-        out.push_str(line);
-        out.push('\n');
-    }
-    out
+    // The wasm-bindgen glue and the service worker, minified (with their
+    // integrity hashes in index.html): tests/e2e/minify-dist.mjs.
+    let script = root().join("tests/e2e/minify-dist.mjs");
+    let minify = Cmd::new("node").args([script.to_string_lossy().as_ref()]);
+    println!("dist: $ {minify}");
+    minify.run()
 }
 
 /// Trunk, told not to look for its own updates: the machine may have no
@@ -97,19 +72,5 @@ fn require_console() -> Result {
         Ok(())
     } else {
         Err("the console is not built yet: index.html is missing (issue 4)".to_string())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::without_comment_lines;
-
-    #[test]
-    fn comment_lines_go_code_stays() {
-        let js = "// head\nconst A = 'a//b'; // tail stays\n\n/**\n * doc\n */\nfunction f() {\n  /* one */\n  return /x\\/\\//;\n}\n";
-        assert_eq!(
-            without_comment_lines(js),
-            "const A = 'a//b'; // tail stays\nfunction f() {\n  return /x\\/\\//;\n}\n"
-        );
     }
 }

@@ -96,9 +96,23 @@ struct SimArgs {
     /// are already burning, as a street at work is).
     #[arg(long, conflicts_with = "nodes")]
     cold_lamps: bool,
+    /// Random lamp failures: the rate per lamp per lit hour (0-60; 0, the
+    /// default, fails none). A failed lamp stays in FAILURE until a reset
+    /// or a power cycle relights it (plm-sim's ballast model).
+    #[arg(long, default_value_t = 0.0, value_parser = failure_rate, conflicts_with = "nodes")]
+    lamp_failures: f64,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+}
+
+fn failure_rate(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(r) if (0.0..=60.0).contains(&r) => Ok(r),
+        _ => Err(format!(
+            "'{s}' is not a failure rate: a number of failures per lamp per lit hour, 0 to 60"
+        )),
+    }
 }
 
 fn parse_index(s: &str) -> Result<u8, String> {
@@ -144,15 +158,18 @@ fn sim(args: SimArgs) -> Result<(), String> {
             lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),
             attach: plm_sim::Attach::Board,
             cold: args.cold_lamps,
+            failures: args.lamp_failures,
         },
         (false, Some(n)) => sim_server::World::Street {
             lamps: n.into(),
             attach: plm_sim::Attach::Modem,
             cold: args.cold_lamps,
+            failures: args.lamp_failures,
         },
-        (false, None) if args.cold_lamps => {
-            return Err("--cold-lamps needs a street of lamps: add --street N or --board".into())
-        }
+        (false, None) if args.cold_lamps || args.lamp_failures > 0.0 => return Err(
+            "--cold-lamps and --lamp-failures need a street of lamps: add --street N or --board"
+                .into(),
+        ),
         (false, None) => sim_server::World::Modems(args.nodes.into()),
     };
     sim_server::run(sim_server::Options {

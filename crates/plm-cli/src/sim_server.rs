@@ -55,6 +55,9 @@ pub enum World {
         /// (otherwise they burn in RUN from the start,
         /// `BallastConfig::warm_start`).
         cold: bool,
+        /// Random lamp failures per lamp per lit hour (0: none;
+        /// `BallastConfig::failure_rate_per_lit_hour`).
+        failures: f64,
     },
 }
 
@@ -87,12 +90,14 @@ pub fn run(opts: Options) -> Result<(), String> {
             lamps,
             attach,
             cold,
+            failures,
         } => (
             {
                 let street = SimConfig::street(lamps, attach);
                 SimConfig {
                     ballast: plm_sim::ballast::BallastConfig {
                         warm_start: !cold,
+                        failure_rate_per_lit_hour: failures,
                         ..street.ballast.clone()
                     },
                     ..street

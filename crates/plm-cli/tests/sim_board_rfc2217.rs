@@ -406,3 +406,31 @@ fn cold_lamps_need_a_street() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--street"), "{err}");
 }
+
+/// `--lamp-failures` needs a street too, and a rate in range.
+#[test]
+fn lamp_failures_need_a_street_and_a_rate() {
+    let plm = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_plm"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (code, err) = plm(&["sim", "--lamp-failures", "2", "--listen", "127.0.0.1:0"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("--street"), "{err}");
+    let (code, err) = plm(&[
+        "sim",
+        "--board",
+        "--lamp-failures",
+        "99",
+        "--listen",
+        "127.0.0.1:0",
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("0 to 60"), "{err}");
+}

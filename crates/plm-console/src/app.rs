@@ -189,11 +189,11 @@ fn LinkProblem() -> impl IntoView {
     let console = use_console();
     let problem = console.conn.last_problem;
     view! {
-        <Show when=move || problem.with(|p| p.is_some())>
+        {move || (problem.with(|p| p.is_some())).then(|| view! {
             <div class="toast" role="status">
                 <span>{move || problem.get().unwrap_or_default()}</span>
                 <button on:click=move |_| problem.set(None)>"Dismiss"</button>
             </div>
-        </Show>
+        })}
     }
 }

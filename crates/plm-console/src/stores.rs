@@ -72,6 +72,9 @@ pub struct SimStore {
     pub nodes: RwSignal<usize>,
     /// Lamps on the simulated street.
     pub lamps: RwSignal<usize>,
+    /// Random lamp failures per lamp per lit hour on the simulated street
+    /// (0: none); kept when the street restarts.
+    pub failure_rate: RwSignal<f64>,
     /// Whether the simulated cable is plugged in.
     pub plugged: RwSignal<bool>,
     /// Frames echoed by the peers.
@@ -202,6 +205,7 @@ pub fn provide_console() -> Console {
         sim: SimStore {
             nodes: RwSignal::new(1),
             lamps: RwSignal::new(STREET_LAMPS),
+            failure_rate: RwSignal::new(0.0),
             plugged: RwSignal::new(true),
             echoed: RwSignal::new(0),
             line_events: RwSignal::new(VecDeque::new()),
@@ -268,12 +272,14 @@ impl Console {
         let profile = self.profile.get_untracked();
         let baud = self.conn.baud.get_untracked();
         let t: Box<dyn Transport> = if profile.is_street() {
-            Box::new(SimTransport::street(
+            let mut street = SimTransport::street(
                 self.sim.lamps.get_untracked(),
                 profile.attach(),
                 baud,
                 SIM_SEED,
-            ))
+            );
+            street.set_failure_rate(self.sim.failure_rate.get_untracked());
+            Box::new(street)
         } else {
             Box::new(SimTransport::new(
                 self.sim.nodes.get_untracked(),

@@ -694,4 +694,28 @@ mod tests {
             assert!(!s.fleet()[&street_address(6)].in_trouble());
         }
     }
+
+    /// Random failures set from the console (the Simulator view's rate)
+    /// reach every lamp of the street and come back as alerts; at rate 0
+    /// nothing fails.
+    #[test]
+    fn random_failures_at_the_rate_set_are_raised() {
+        let failures_at = |rate: f64| {
+            let t = Box::new(SimTransport::street(6, Attach::Board, 57_600, 4));
+            let mut s = StreetSession::new(t, Concentrator::usart(RequesterConfig::default()));
+            s.discover();
+            run(&mut s, 30 * S);
+            assert_eq!(s.fleet().len(), 6);
+            let sim = s.transport_mut().unwrap().simulator().unwrap();
+            sim.set_failure_rate(rate);
+            let alerts = run(&mut s, 180 * S);
+            alerts
+                .iter()
+                .filter(|a| a.what.starts_with("lamp failed"))
+                .count()
+        };
+        assert_eq!(failures_at(0.0), 0);
+        // 60 per lit hour: each lamp fails about once a minute.
+        assert!(failures_at(60.0) >= 2);
+    }
 }

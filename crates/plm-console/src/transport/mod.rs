@@ -83,6 +83,9 @@ pub trait Simulator {
     /// Does something to the lamp of street node `node` (1..): faults on
     /// demand for demos and tests.
     fn lamp(&mut self, node: usize, action: LampAction);
+    /// Random lamp failures from now on, per lamp per lit hour (0: none),
+    /// on every lamp of a simulated street.
+    fn set_failure_rate(&mut self, per_lit_hour: f64);
 }
 
 /// What the Simulator view can do to one lamp of a simulated street.

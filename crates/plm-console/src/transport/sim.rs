@@ -132,6 +132,16 @@ impl Simulator for SimTransport {
         std::iter::from_fn(|| self.sim.poll_line_event()).collect()
     }
 
+    fn set_failure_rate(&mut self, per_lit_hour: f64) {
+        for node in 1..self.sim.nodes() {
+            self.sim.with_board(node, |b, now| {
+                if let Some(ballast) = b.ballast_mut() {
+                    ballast.set_failure_rate(now, per_lit_hour);
+                }
+            });
+        }
+    }
+
     fn lamp(&mut self, node: usize, action: LampAction) {
         let cut = match action {
             LampAction::Cut => Some(true),

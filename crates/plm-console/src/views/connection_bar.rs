@@ -99,7 +99,7 @@ pub fn ConnectionBar() -> impl IntoView {
                     {move || if conn.treq.get() { "low" } else { "high" }}
                 </b>
             </span>
-            <Show when=move || conn.retries.get() != 0>
+            {move || (conn.retries.get() != 0).then(|| view! {
                 <span
                     class="item warn"
                     id="conn-retries"
@@ -112,7 +112,7 @@ pub fn ConnectionBar() -> impl IntoView {
                 >
                     "Repeats " <b>{move || conn.retries.get()}</b>
                 </span>
-            </Show>
+            })}
             <span class="item muted" title="Host-interface timeouts (MIB 09h)" hidden=move || !modem()>
                 {move || {
                     let t = conn.timeouts.get();

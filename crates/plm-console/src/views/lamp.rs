@@ -162,7 +162,10 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         }).collect_view()}
                         <div class="form-row">
                             {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
-                            <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                            <label>
+                                "Dimming % "
+                                <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                            </label>
                             <button id="lamp-dim" on:click=move |_| {
                                 match dimming_value(&level.get_untracked()) {
                                     Ok(v) => {
@@ -214,7 +217,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             }>"Write"</button>
                         </div>
                         <input id="lamp-params" class="payload hex" placeholder="32 bytes, hex" prop:value=move || params.get() on:input=move |ev| params.set(event_target_value(&ev))/>
-                        <Show when=move || street.port.get().contains("simulated")>
+                        {move || (street.port.get().contains("simulated")).then(|| view! {
                             <div class="form-row sim-actions">
                                 <span class="muted">"Simulator:"</span>
                                 {button("lamp-sim-fail", "Break lamp", "", move || sim(LampAction::Fail))}
@@ -222,7 +225,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 {button("lamp-sim-cut", "Cut supply", "", move || sim(LampAction::Cut))}
                                 {button("", "Restore supply", "", move || sim(LampAction::Join))}
                             </div>
-                        </Show>
+                        })}
                         <p class="muted" id="lamp-note">{move || note.get().unwrap_or_default()}</p>
                     }.into_any()
                 }

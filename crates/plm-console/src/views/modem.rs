@@ -136,9 +136,9 @@ fn Profiles() -> impl IntoView {
             "Load profile…"
             <input id="profile-load" type="file" accept=".json,application/json" on:change=load/>
         </label>
-        <Show when=move || running.get()>
+        {move || (running.get()).then(|| view! {
             <button id="profile-cancel" on:click=move |_| cancel.set(true)>"Cancel"</button>
-        </Show>
+        })}
         <span class="muted" id="profile-message">{move || message.get()}</span>
     }
 }

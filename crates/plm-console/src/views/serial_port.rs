@@ -411,7 +411,7 @@ mod wasm {
                 >
                     {controls}
                     <div class="buttons" style="margin-top: 10px">
-                        <Show when=move || supported>
+                        {move || (supported).then(|| view! {
                             <button
                                 id="serial-connect"
                                 disabled=move || busy.get() || labels.with(Vec::is_empty)
@@ -419,7 +419,7 @@ mod wasm {
                             >
                                 {move || if active() { "Reconnect" } else { "Connect over WebSerial" }}
                             </button>
-                        </Show>
+                        })}
                         <button
                             id="serial-use-sim"
                             disabled=move || console.conn.kind.get() == "Simulated"
@@ -429,11 +429,11 @@ mod wasm {
                         </button>
                         <button id="serial-close" on:click=move |_| open.set(false)>"Close"</button>
                     </div>
-                    <Show when=move || message.with(Option::is_some)>
+                    {move || (message.with(Option::is_some)).then(|| view! {
                         <p class="message" id="serial-message" role="status">
                             {move || message.get().unwrap_or_default()}
                         </p>
-                    </Show>
+                    })}
                 </div>
             </span>
         }

@@ -102,7 +102,45 @@ fn StreetCard() -> impl IntoView {
             }>
                 "Restart the street"
             </button>
+            <FailureRate/>
         </article>
+    }
+}
+
+/// Random lamp failures per lamp per lit hour, on the running street and
+/// the next ones.
+#[component]
+fn FailureRate() -> impl IntoView {
+    let c = use_console();
+    let text = RwSignal::new(super::fixed(c.sim.failure_rate.get_untracked(), 2));
+    let message = RwSignal::new(None::<String>);
+    let apply = move || match super::decimal(&text.get_untracked()) {
+        Some(rate) if (0.0..=60.0).contains(&rate) => {
+            c.sim.failure_rate.set(rate);
+            c.with_simulator(|s| s.set_failure_rate(rate));
+            message.set(Some(if rate == 0.0 {
+                "no random failures".to_string()
+            } else {
+                format!(
+                    "each burning lamp fails about every {} minutes (it stays in FAILURE until reset)",
+                    super::fixed(60.0 / rate, 1)
+                )
+            }));
+        }
+        _ => message.set(Some(
+            "nothing changed: the rate is a number of failures per lamp per lit hour, 0 to 60"
+                .to_string(),
+        )),
+    };
+    view! {
+        <div class="form-row">
+            <label title="Random lamp failures, per lamp per hour of burning (0: none). A failed lamp stays in FAILURE until a reset or a power cycle relights it.">
+                "Random failures per lamp per lit hour "
+                {super::widgets::text_input("sim-failure-rate", "", "", Some(5), text)}
+            </label>
+            {super::widgets::button("sim-apply-failures", "Apply", "", apply)}
+        </div>
+        {super::widgets::note("sim-failure-note", "muted", message)}
     }
 }
 

@@ -64,9 +64,9 @@ pub fn StreetView() -> impl IntoView {
                 {button("street-export-json", "Export JSON", "", move || export(true))}
             </div>
             <GroupActions selected=selected message=message/>
-            <Show when=move || message.with(|m| m.is_some())>
+            {move || (message.with(|m| m.is_some())).then(|| view! {
                 <p class="message" id="street-message">{move || message.get().unwrap_or_default()}</p>
-            </Show>
+            })}
             <Alerts focus=focus/>
             <div class="street-grid" class:with-lamp=move || focus.with(|f| f.is_some())>
                 <div class="table-wrap">
@@ -161,7 +161,7 @@ pub fn StreetView() -> impl IntoView {
                             />
                         </tbody>
                     </table>
-                    <Show when=move || rows.with(|r| r.is_empty())>
+                    {move || (rows.with(|r| r.is_empty())).then(|| view! {
                         <p class="muted empty">
                             {move || if street.discovering.get().is_some() {
                                 "Looking for lamps on the line…"
@@ -169,11 +169,11 @@ pub fn StreetView() -> impl IntoView {
                                 "No lamp matches. Discover finds the lamps on the line."
                             }}
                         </p>
-                    </Show>
+                    })}
                 </div>
-                <Show when=move || focus.with(|f| f.is_some())>
+                {move || (focus.with(|f| f.is_some())).then(|| view! {
                     <super::lamp::LampPanel focus=focus/>
-                </Show>
+                })}
             </div>
         </div>
     }
@@ -199,7 +199,11 @@ fn SweepControl() -> impl IntoView {
             {move || match (street.discovering.get(), street.sweep.get()) {
                 (Some(round), _) => format!("discovering (round {round})…"),
                 (None, s) if s.on && s.total > 0 => format!("reading {}/{} (sweep {})", s.done, s.total, s.rounds + 1),
-                (None, s) if s.on => format!("{} sweeps done; next in a few seconds", s.rounds),
+                (None, s) if s.on => format!(
+                    "{} sweep{} done; next in a few seconds",
+                    s.rounds,
+                    if s.rounds == 1 { "" } else { "s" }
+                ),
                 _ => String::new(),
             }}
         </span>
@@ -310,7 +314,7 @@ fn GroupActions(
 fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
     let street = use_console().street;
     view! {
-        <Show when=move || street.alerts.with(|a| !a.is_empty())>
+        {move || (street.alerts.with(|a| !a.is_empty())).then(|| view! {
             <div class="alerts" id="street-alerts" role="alert">
                 <div class="alerts-head">
                     <b>{move || format!("{} alert(s)", street.alerts.with(|a| a.len()))}</b>
@@ -328,7 +332,7 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
                     }).collect_view()}
                 </ul>
             </div>
-        </Show>
+        })}
     }
 }
 

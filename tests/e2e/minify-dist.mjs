@@ -1,0 +1,33 @@
+// Minifies the JavaScript of a release build in dist/ (the wasm-bindgen
+// glue and the service worker) with terser, and rewrites the Subresource
+// Integrity hashes index.html gives for them. `cargo xtask dist` runs it
+// after Trunk: the console's 350 KiB budget counts every JS file, and
+// Trunk's own minifier leaves these two as they are. The sources keep
+// their comments; only the copies the browser downloads are minified.
+//
+// node minify-dist.mjs [DIST]   (default: ../../dist)
+
+import crypto from 'node:crypto';
+import fs from 'node:fs/promises';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { minify } from 'terser';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const dist = path.resolve(process.argv[2] ?? path.join(here, '../../dist'));
+const sri = (body) => `sha384-${crypto.createHash('sha384').update(body).digest('base64')}`;
+
+let html = await fs.readFile(path.join(dist, 'index.html'), 'utf8');
+for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sort()) {
+  const file = path.join(dist, name);
+  const before = await fs.readFile(file, 'utf8');
+  // The service worker is a classic script; the wasm-bindgen glue a module.
+  const module = name !== 'sw.js';
+  const out = await minify(before, { module, compress: true, mangle: true });
+  if (out.code === undefined) throw new Error(`${name}: terser produced nothing`);
+  await fs.writeFile(file, out.code);
+  const old = sri(before);
+  if (html.includes(old)) html = html.replaceAll(old, sri(out.code));
+  console.log(`minify-dist: ${name} ${before.length} -> ${out.code.length} bytes`);
+}
+await fs.writeFile(path.join(dist, 'index.html'), html);
