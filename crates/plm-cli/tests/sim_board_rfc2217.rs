@@ -222,7 +222,7 @@ fn concentrator_board_over_rfc2217_discovers_reads_and_dims_a_street() {
     // 1. Discovery: every lamp answers once per session, is acknowledged,
     // and nothing but the street's lamps answers.
     let (discovery, replies) = d.discover(1, Discovery::window_for(5), 6);
-    let found: &BTreeMap<Address, Discovered> = discovery.found();
+    let found: BTreeMap<Address, Discovered> = discovery.found().iter().copied().collect();
     let lamps: Vec<Address> = (1..=5).map(street_address).collect();
     assert_eq!(
         found.keys().copied().collect::<Vec<_>>(),

@@ -165,6 +165,6 @@ impl StreetDriver {
                 self.submit(next);
             }
         }
-        d.found().clone()
+        d.found().iter().copied().collect()
     }
 }

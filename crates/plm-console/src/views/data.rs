@@ -15,6 +15,10 @@ use plm_core::st7580::{
     validate, Command, DataRequest, FrequencySet, Modulation, SsDataRequest, TxParams,
 };
 
+/// Received frames shown, the most recent (the traffic log keeps them all).
+const INDICATION_ROWS: usize = 200;
+
+/// The indications that carry a received frame (UM0932 Table 39).
 const INDICATIONS: &[&str] = &[
     "PHY_DataIndication",
     "DL_DataIndication",
@@ -330,7 +334,7 @@ fn DataRequestCard() -> impl IntoView {
 fn Indications() -> impl IntoView {
     let c = use_console();
     let rows = Memo::new(move |_| {
-        c.traffic.log.with(|l| {
+        let mut rows = c.traffic.log.with(|l| {
             l.iter()
                 .filter(|e| {
                     e.decoded
@@ -341,7 +345,10 @@ fn Indications() -> impl IntoView {
                 })
                 .cloned()
                 .collect::<Vec<_>>()
-        })
+        });
+        let older = rows.len().saturating_sub(INDICATION_ROWS);
+        rows.drain(..older);
+        rows
     });
     view! {
         <article class="card wide" id="data-indications">
@@ -384,10 +391,9 @@ fn Indications() -> impl IntoView {
                     </tr>
                 </thead>
                 <tbody>
-                    <For
-                        each=move || rows.get()
-                        key=|e| e.seq
-                        children=move |e| {
+                    // At most INDICATION_ROWS rows, rebuilt when one arrives: no
+                    // keyed list needed (and none of its code in the wasm).
+                    {move || rows.get().into_iter().map(|e| {
                             view! {
                                 <tr>
                                     <td class="time">{e.at.map(seconds).unwrap_or_default()}</td>
@@ -400,8 +406,7 @@ fn Indications() -> impl IntoView {
                                     <td class="hex">{spaced(&payload(&e))}</td>
                                 </tr>
                             }
-                        }
-                    />
+                        }).collect_view()}
                 </tbody>
             </table>
         </article>

@@ -10,7 +10,6 @@ use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::app::service::{Clock, Service};
 use plm_core::app::{Address, Message, Request};
-use std::collections::BTreeSet;
 
 /// The view.
 #[component]
@@ -18,7 +17,8 @@ pub fn StreetView() -> impl IntoView {
     let street = use_console().street;
     let filter = RwSignal::new(String::new());
     let sort = RwSignal::new(("address", true));
-    let selected = RwSignal::new(BTreeSet::<Address>::new());
+    // The lamps ticked, in the order they were ticked.
+    let selected = RwSignal::new(Vec::<Address>::new());
     let focus = RwSignal::new(None::<Address>);
     let message = RwSignal::new(None::<String>);
     // The rows shown, sorted and filtered; the table keys its lines by
@@ -83,7 +83,7 @@ pub fn StreetView() -> impl IntoView {
                                             selected.set(if on {
                                                 rows.get_untracked().iter().map(|r| r.address).collect()
                                             } else {
-                                                BTreeSet::new()
+                                                Vec::new()
                                             });
                                         }
                                     />
@@ -134,7 +134,8 @@ pub fn StreetView() -> impl IntoView {
                                                     on:change=move |ev| {
                                                         let on = event_target_checked(&ev);
                                                         selected.update(|s| {
-                                                            if on { s.insert(address); } else { s.remove(&address); }
+                                                            s.retain(|a| *a != address);
+                                                            if on { s.push(address); }
                                                         });
                                                     }
                                                 />
@@ -236,7 +237,7 @@ pub(super) fn computer_clock() -> Clock {
 
 #[component]
 fn GroupActions(
-    selected: RwSignal<BTreeSet<Address>>,
+    selected: RwSignal<Vec<Address>>,
     message: RwSignal<Option<String>>,
 ) -> impl IntoView {
     let street = use_console().street;
@@ -279,7 +280,7 @@ fn GroupActions(
             <button
                 id="street-dim-selected"
                 prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=move |_| dim(Some(selected.get_untracked().into_iter().collect()))
+                on:click=move |_| dim(Some(selected.get_untracked()))
             >
                 {move || format!("Dim selected ({})", selected.with(|s| s.len()))}
             </button>
@@ -292,7 +293,7 @@ fn GroupActions(
                 prop:disabled=move || selected.with(|s| s.is_empty())
                 on:click=move |_| {
                     let c = computer_clock();
-                    let list: Vec<Address> = selected.get_untracked().into_iter().collect();
+                    let list = selected.get_untracked();
                     let r = street.act(|s| {
                         list.iter().try_for_each(|a| {
                             s.request(Request::to(*a, Message::Service(Service::ClockSet(c))), Box::new(|_| {}))

@@ -19,7 +19,7 @@ use super::message::Message;
 use super::requester::Request;
 use super::service::{Discovered, Service};
 use crate::time::{Duration, Instant, MS};
-use alloc::collections::BTreeMap;
+use alloc::vec::Vec;
 
 /// Answers a second of window holds with few collisions: an answer and
 /// its ACK take about 0.1 s on the line at B-PSK.
@@ -46,7 +46,10 @@ pub struct Discovery {
     previous: Option<usize>,
     /// The last round heard a quarter of what its window holds.
     crowded: bool,
-    found: BTreeMap<Address, Discovered>,
+    /// Boards found, in the order they were heard (a list: a street is
+    /// at most a few hundred boards, and the console carries no map code
+    /// for it).
+    found: Vec<(Address, Discovered)>,
     done: bool,
 }
 
@@ -66,7 +69,7 @@ impl Discovery {
             found_before: 0,
             previous: None,
             crowded: false,
-            found: BTreeMap::new(),
+            found: Vec::new(),
             done: false,
         };
         let r = d.next_round(now);
@@ -134,7 +137,10 @@ impl Discovery {
         let Message::Service(Service::DiscoverReply(d)) = message else {
             return None;
         };
-        self.found.insert(address, *d);
+        match self.found.iter_mut().find(|(a, _)| *a == address) {
+            Some(known) => known.1 = *d,
+            None => self.found.push((address, *d)),
+        }
         self.heard_in_round += 1;
         Some(message.ack().to(address))
     }
@@ -182,8 +188,8 @@ impl Discovery {
         self.round
     }
 
-    /// The boards found, by address.
-    pub fn found(&self) -> &BTreeMap<Address, Discovered> {
+    /// The boards found, in the order they were first heard.
+    pub fn found(&self) -> &[(Address, Discovered)] {
         &self.found
     }
 }
