@@ -28,6 +28,10 @@ SERVICE = {
     0x06: "SERVICE_FW_REL_GET", 0x07: "SERVICE_PLM_CLOCK_SET", 0x08: "SERVICE_PLM_CLOCK_GET",
     0x09: "SERVICE_IO_CONFIG_SET", 0x0A: "SERVICE_IO_CONFIG_GET", 0x0B: "SERVICE_NET_DISCOVER_REQ",
     0x0F: "SERVICE_SN_SET", 0x10: "SERVICE_SN_GET",
+    0x0C: "SERVICE_RFU_SET_IMG_HEADER", 0x0D: "SERVICE_RFU_SET_IMG_DATA",
+    0x0E: "SERVICE_RFU_SWAP_IMG",
+    # User-defined (4.5: "0x0b to 0x7f"), this project's (protocol notes).
+    0x11: "RFU_STATUS_GET", 0x12: "RFU_ABORT",
 }
 PROG_GRP_USER_DATA = 0x02
 
@@ -160,6 +164,50 @@ v("SERVICE_NET_DISCOVER_REQ reply", D, 16,
   [16, APP_SERVICE_FRAME, *ADDR, 0x0B, 1, 2, 3, 4, 20],
   svc(0x0B, "reply", {"firmware_major": 1, "firmware_minor": 2, "stack_major": 3,
                       "stack_minor": 4, "snr": 20}))
+
+# Remote firmware update (4.2): the seed names 0Ch-0Eh without layouts; these
+# are the project's (docs/protocol-notes.md, "Remote firmware update"), with
+# two user-defined commands. Numbers big-endian; CRC-32/ISO-HDLC (zlib's).
+import zlib
+R = "project decision (docs/protocol-notes.md); seed 4.2 and 4.5 name 0Ch-0Eh only"
+IMAGE = bytes((i * 7 + 3) & 0xFF for i in range(200))  # 3 segments of 96 bytes
+IMAGE_CRC = zlib.crc32(IMAGE)
+assert zlib.crc32(b"123456789") == 0xCBF43926
+CAMPAIGN = 7
+be32 = lambda x: [(x >> 24) & 0xFF, (x >> 16) & 0xFF, (x >> 8) & 0xFF, x & 0xFF]
+v("SERVICE_RFU_SET_IMG_HEADER request", R, 23,
+  [23, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0C, CAMPAIGN, *be32(len(IMAGE)), 1, 5,
+   *be32(IMAGE_CRC), 96],
+  svc(0x0C, "request", {"campaign": CAMPAIGN, "image_size": len(IMAGE), "version_major": 1,
+                        "version_minor": 5, "image_crc32": IMAGE_CRC, "segment_size": 96},
+      broadcast=True))
+v("SERVICE_RFU_SET_IMG_HEADER ACK", R, 12,
+  [12, APP_ACK_FRAME, *ADDR, APP_SERVICE_FRAME, 0x0C], ack(APP_SERVICE_FRAME, 0x0C))
+SEG1 = list(IMAGE[96:192])
+v("SERVICE_RFU_SET_IMG_DATA request (a full segment)", R, 110,
+  [110, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0D, CAMPAIGN, 0x00, 0x01, *SEG1],
+  svc(0x0D, "request", {"campaign": CAMPAIGN, "segment": 1, "data": bytes(SEG1).hex()},
+      broadcast=True))
+SEG2 = list(IMAGE[192:])
+v("SERVICE_RFU_SET_IMG_DATA request (the last, short segment)", R, 14 + len(SEG2),
+  [14 + len(SEG2), APP_SERVICE_FRAME, *ADDR, 0x0D, CAMPAIGN, 0x00, 0x02, *SEG2],
+  svc(0x0D, "request", {"campaign": CAMPAIGN, "segment": 2, "data": bytes(SEG2).hex()}))
+v("RFU_STATUS_GET request", R, 12,
+  [12, APP_SERVICE_FRAME, *ADDR, 0x11, CAMPAIGN], svc(0x11, "request", {"campaign": CAMPAIGN}))
+BITMAP = [0b101] + [0] * 79  # segments 0 and 2 held, 1 missing
+v("RFU_STATUS_GET reply", R, 96,
+  [96, APP_SERVICE_FRAME, *ADDR, 0x11, CAMPAIGN, 1, 3, 0x00, 0x02, *BITMAP],
+  svc(0x11, "reply", {"campaign": CAMPAIGN, "state": "RECEIVING", "reason": "SEGMENTS_MISSING",
+                      "received": 2, "bitmap": bytes(BITMAP).hex()}))
+v("SERVICE_RFU_SWAP_IMG request", R, 16,
+  [16, APP_SERVICE_FRAME, *ADDR, 0x0E, CAMPAIGN, *be32(IMAGE_CRC)],
+  svc(0x0E, "request", {"campaign": CAMPAIGN, "image_crc32": IMAGE_CRC}))
+v("SERVICE_RFU_SWAP_IMG ACK", R, 12,
+  [12, APP_ACK_FRAME, *ADDR, APP_SERVICE_FRAME, 0x0E], ack(APP_SERVICE_FRAME, 0x0E))
+v("RFU_ABORT request", R, 12,
+  [12, APP_SERVICE_FRAME, *ADDR, 0x12, CAMPAIGN], svc(0x12, "request", {"campaign": CAMPAIGN}))
+v("RFU_ABORT ACK", R, 12,
+  [12, APP_ACK_FRAME, *ADDR, APP_SERVICE_FRAME, 0x12], ack(APP_SERVICE_FRAME, 0x12))
 
 # 4.6.2 Ping frames and their ACK (the ping's command echo: 0, protocol notes).
 P = "STEVAL-IHP007V1 UM 4.6.2 Ping frames"

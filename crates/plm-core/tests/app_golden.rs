@@ -7,6 +7,7 @@
 
 use plm_core::app::crc::{crc16, SEED_TABLE_TYPOS};
 use plm_core::app::hid::{self, Hid};
+use plm_core::app::rfu;
 use plm_core::app::service::{self, Answer, Clock, Discovered, Release, Service};
 use plm_core::app::{Address, AppFrame, ErrorCode, FrameType, Message};
 use plm_core::decode_app::decode_usart;
@@ -103,6 +104,34 @@ fn the_seed_table_differs_from_the_polynomial_exactly_at_the_known_typos() {
     }
 }
 
+/// The image of the RFU vectors (make_steval.py): 200 bytes, 3 segments.
+fn rfu_image() -> Vec<u8> {
+    (0..200u32).map(|i| ((i * 7 + 3) & 0xFF) as u8).collect()
+}
+
+/// CRC-32/ISO-HDLC bit by bit (reflected polynomial EDB88320h, init and
+/// final XOR FFFFFFFFh), written here apart from plm-core's.
+fn crc32_bitwise(data: &[u8]) -> u32 {
+    let mut crc = 0xFFFF_FFFFu32;
+    for &b in data {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+#[test]
+fn the_rfu_crc_is_the_standard_crc32() {
+    assert_eq!(crc32_bitwise(b"123456789"), 0xCBF4_3926);
+    assert_eq!(rfu::image_crc(&rfu_image()), crc32_bitwise(&rfu_image()));
+}
+
 /// The typed message each vector is, written from the seed.
 fn typed(name: &str) -> Option<Message> {
     use Service::*;
@@ -189,6 +218,39 @@ fn typed(name: &str) -> Option<Message> {
             stack: Release { major: 3, minor: 4 },
             snr: 20,
         })),
+        "SERVICE_RFU_SET_IMG_HEADER request" => s(RfuHeader(rfu::Header {
+            campaign: 7,
+            size: 200,
+            version: Release { major: 1, minor: 5 },
+            crc: crc32_bitwise(&rfu_image()),
+            segment: 96,
+        })),
+        "SERVICE_RFU_SET_IMG_DATA request (a full segment)" => s(RfuData {
+            campaign: 7,
+            segment: 1,
+            data: rfu_image()[96..192].to_vec(),
+        }),
+        "SERVICE_RFU_SET_IMG_DATA request (the last, short segment)" => s(RfuData {
+            campaign: 7,
+            segment: 2,
+            data: rfu_image()[192..].to_vec(),
+        }),
+        "SERVICE_RFU_SWAP_IMG request" => s(RfuSwap {
+            campaign: 7,
+            crc: crc32_bitwise(&rfu_image()),
+        }),
+        "RFU_STATUS_GET request" => s(RfuStatusGet { campaign: 7 }),
+        "RFU_STATUS_GET reply" => s(RfuStatus(rfu::Status {
+            campaign: 7,
+            state: 1,
+            reason: 3,
+            received: 2,
+            bitmap: [vec![0b101], vec![0; 79]].concat(),
+        })),
+        "RFU_ABORT request" => s(RfuAbort { campaign: 7 }),
+        "SERVICE_RFU_SET_IMG_HEADER ACK" => ack(FrameType::Service, 0x0C),
+        "SERVICE_RFU_SWAP_IMG ACK" => ack(FrameType::Service, 0x0E),
+        "RFU_ABORT ACK" => ack(FrameType::Service, 0x12),
         "SERVICE_PARAM_SET ACK" => ack(FrameType::Service, 0x02),
         "SERVICE_IO_CONFIG_SET ACK" => ack(FrameType::Service, 0x09),
         "SERVICE_OUTPUTS_SET ACK" => ack(FrameType::Service, 0x05),
@@ -298,9 +360,9 @@ fn every_vector_is_its_typed_message_and_emits_back_to_the_same_bytes() {
 }
 
 /// Every layout the seed gives has a vector: each service command's
-/// request and its answer (00h-10h but the RFU 0Ch-0Eh, defined with the
-/// RFU protocol), each HID command and each 'g' reply, ping, ACKs, error
-/// and data frames.
+/// request and its answer (00h-10h, with the RFU commands 0Ch-0Eh whose
+/// layouts are the project's, and its user-defined 11h-12h), each HID
+/// command and each 'g' reply, ping, ACKs, error and data frames.
 #[test]
 fn the_vectors_cover_every_layout() {
     let messages: Vec<Message> = vectors()
@@ -309,9 +371,6 @@ fn the_vectors_cover_every_layout() {
         .collect();
     let has = |f: &dyn Fn(&Message) -> bool| messages.iter().any(f);
     for d in service::COMMANDS {
-        if (0x0C..=0x0E).contains(&d.code) {
-            continue;
-        }
         assert!(
             has(&|m| matches!(m, Message::Service(s) if s.command() == d.code && s.is_request())),
             "{} request",

@@ -6,6 +6,7 @@
 //! time without panicking, and settle every request.
 
 use plm_core::app::hid::{self, Hid};
+use plm_core::app::rfu;
 use plm_core::app::service::{Clock, Discovered, Release, Service};
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, ErrorCode, FrameError, FrameType, Happening,
@@ -88,14 +89,45 @@ fn service() -> impl Strategy<Value = Service> {
                 snr,
             })
         }),
-        // RFU 0Ch-0Eh (layouts not described yet) and user commands.
-        (
-            prop_oneof![0x0Cu8..=0x0E, 0x11u8..=0xFF],
-            vec(any::<u8>(), 0..MAX_PAYLOAD)
-        )
+        // User commands this project does not know.
+        (0x13u8..=0xFF, vec(any::<u8>(), 0..MAX_PAYLOAD))
             .prop_map(|(command, data)| Raw { command, data }),
     ];
-    prop_oneof![no_data, one_byte, more]
+    let rfu = prop_oneof![
+        (any::<(u8, u32, u32, u8)>(), release()).prop_map(
+            |((campaign, size, crc, segment), version)| RfuHeader(rfu::Header {
+                campaign,
+                size,
+                version,
+                crc,
+                segment,
+            })
+        ),
+        (any::<(u8, u16)>(), vec(any::<u8>(), 0..=rfu::SEGMENT)).prop_map(
+            |((campaign, segment), data)| RfuData {
+                campaign,
+                segment,
+                data
+            }
+        ),
+        any::<(u8, u32)>().prop_map(|(campaign, crc)| RfuSwap { campaign, crc }),
+        any::<u8>().prop_map(|campaign| RfuStatusGet { campaign }),
+        any::<u8>().prop_map(|campaign| RfuAbort { campaign }),
+        (
+            any::<(u8, u8, u8, u16)>(),
+            vec(any::<u8>(), rfu::BITMAP_LEN)
+        )
+            .prop_map(|((campaign, state, reason, received), bitmap)| RfuStatus(
+                rfu::Status {
+                    campaign,
+                    state,
+                    reason,
+                    received,
+                    bitmap,
+                }
+            )),
+    ];
+    prop_oneof![no_data, one_byte, more, rfu]
 }
 
 /// Every variant of [`Hid`] (Appendix A); replies carry a value of their

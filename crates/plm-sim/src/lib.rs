@@ -30,6 +30,7 @@ pub mod ballast;
 pub mod board;
 pub mod drive;
 pub mod echo;
+pub mod flash;
 pub mod line;
 pub mod modem;
 pub mod rng;

@@ -12,6 +12,7 @@
 //! - [`usart`]: the USART stream decoder; [`requester`]: requests and
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
 //!   USART or a bare ST7580; [`discovery`]: finding the boards on a line.
+//! - [`rfu`]: remote firmware update, the layouts of its commands.
 //!
 //! Decisions where the seed is silent are in docs/protocol-notes.md
 //! ("STEVAL-IHP007V1 application layer").
@@ -25,6 +26,7 @@ pub mod hid;
 pub mod line;
 pub mod message;
 pub mod requester;
+pub mod rfu;
 pub mod service;
 pub mod usart;
 

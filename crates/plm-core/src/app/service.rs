@@ -8,6 +8,7 @@
 //! frame is read without knowing which way it went.
 
 use super::error::ErrorCode;
+use super::rfu::{self, fields as rf};
 use crate::field::{self, Field, FieldError};
 use alloc::vec::Vec;
 use core::fmt;
@@ -37,7 +38,8 @@ pub enum Answer {
     Ack,
     /// A service frame of the same command with this data.
     Reply(&'static [Field], usize),
-    /// Not described yet (the RFU commands' layouts come with RFU).
+    /// Not described (user-defined commands this project does not
+    /// know).
     Undefined,
 }
 
@@ -129,7 +131,9 @@ pub mod fields {
 
 use fields as f;
 
-/// Every native service command (4.5, 4.6.4), by code.
+/// Every native service command (4.5, 4.6.4), by code, and the
+/// user-defined ones this project adds for the remote firmware update
+/// (11h-12h, [`rfu`]).
 pub const COMMANDS: &[ServiceDesc] = &[
     ServiceDesc {
         code: 0x00,
@@ -230,26 +234,27 @@ pub const COMMANDS: &[ServiceDesc] = &[
     ServiceDesc {
         code: 0x0c,
         name: "SERVICE_RFU_SET_IMG_HEADER",
-        what: "Remote firmware update: image header",
-        request: &[f::DATA],
-        request_len: None,
-        answer: Answer::Undefined,
+        what: "Remote firmware update: a new image is coming (its header)",
+        request: rf::HEADER,
+        request_len: Some(rfu::len::HEADER),
+        answer: Answer::Ack,
     },
     ServiceDesc {
         code: 0x0d,
         name: "SERVICE_RFU_SET_IMG_DATA",
-        what: "Remote firmware update: image segment",
-        request: &[f::DATA],
+        what: "Remote firmware update: one segment of the image",
+        request: rf::DATA,
+        // 3 + 1..=96: any length is a request (there is no reply).
         request_len: None,
-        answer: Answer::Undefined,
+        answer: Answer::None,
     },
     ServiceDesc {
         code: 0x0e,
         name: "SERVICE_RFU_SWAP_IMG",
-        what: "Remote firmware update: check and boot the new image",
-        request: &[f::DATA],
-        request_len: None,
-        answer: Answer::Undefined,
+        what: "Remote firmware update: check the image and boot it",
+        request: rf::SWAP,
+        request_len: Some(rfu::len::SWAP),
+        answer: Answer::Ack,
     },
     ServiceDesc {
         code: 0x0f,
@@ -266,6 +271,22 @@ pub const COMMANDS: &[ServiceDesc] = &[
         request: &[],
         request_len: Some(0),
         answer: Answer::Reply(&[f::SNR], 1),
+    },
+    ServiceDesc {
+        code: rfu::RFU_STATUS_GET,
+        name: "RFU_STATUS_GET",
+        what: "Remote firmware update: which segments the board holds",
+        request: rf::CAMPAIGN_ONLY,
+        request_len: Some(1),
+        answer: Answer::Reply(rf::STATUS, rfu::len::STATUS),
+    },
+    ServiceDesc {
+        code: rfu::RFU_ABORT,
+        name: "RFU_ABORT",
+        what: "Remote firmware update: forget the campaign",
+        request: rf::CAMPAIGN_ONLY,
+        request_len: Some(1),
+        answer: Answer::Ack,
     },
 ];
 
@@ -407,8 +428,38 @@ pub enum Service {
     SnGet,
     /// 10h reply.
     Sn(u8),
-    /// A command whose layout is not described (RFU 0Ch-0Eh until the
-    /// RFU protocol, user-defined commands), kept as bytes.
+    /// 0Ch.
+    RfuHeader(rfu::Header),
+    /// 0Dh.
+    RfuData {
+        /// Campaign.
+        campaign: u8,
+        /// Segment number.
+        segment: u16,
+        /// Its bytes (1 to 96).
+        data: Vec<u8>,
+    },
+    /// 0Eh.
+    RfuSwap {
+        /// Campaign.
+        campaign: u8,
+        /// The CRC-32 the image must have.
+        crc: u32,
+    },
+    /// 11h request.
+    RfuStatusGet {
+        /// Campaign asked about.
+        campaign: u8,
+    },
+    /// 11h reply.
+    RfuStatus(rfu::Status),
+    /// 12h.
+    RfuAbort {
+        /// Campaign to forget.
+        campaign: u8,
+    },
+    /// A command whose layout is not described (user-defined commands
+    /// this project does not know), kept as bytes.
     Raw {
         /// Command code.
         command: u8,
@@ -467,6 +518,10 @@ impl ServiceError {
 
 fn get(f: &Field, d: &[u8]) -> u8 {
     f.get(d).unwrap_or(0) as u8
+}
+
+fn get_u32(f: &Field, d: &[u8]) -> u32 {
+    f.get(d).unwrap_or(0) as u32
 }
 
 fn release(d: &[u8], major: &Field, minor: &Field) -> Release {
@@ -550,6 +605,35 @@ impl Service {
             (0x0f, _) => Service::SnSet(get(&f::SNR, d)),
             (0x10, true) => Service::SnGet,
             (0x10, false) => Service::Sn(get(&f::SNR, d)),
+            (0x0c, _) => Service::RfuHeader(rfu::Header {
+                campaign: get(&rf::CAMPAIGN, d),
+                size: get_u32(&rf::IMAGE_SIZE, d),
+                version: release(d, &rf::VERSION_MAJOR, &rf::VERSION_MINOR),
+                crc: get_u32(&rf::IMAGE_CRC, d),
+                segment: get(&rf::SEGMENT_SIZE, d),
+            }),
+            (0x0d, _) => Service::RfuData {
+                campaign: get(&rf::CAMPAIGN, d),
+                segment: get_u32(&rf::SEGMENT_NUMBER, d) as u16,
+                data: d.get(3..).unwrap_or(&[]).to_vec(),
+            },
+            (0x0e, _) => Service::RfuSwap {
+                campaign: get(&rf::CAMPAIGN, d),
+                crc: get_u32(&rf::SWAP_CRC, d),
+            },
+            (rfu::RFU_STATUS_GET, true) => Service::RfuStatusGet {
+                campaign: get(&rf::CAMPAIGN, d),
+            },
+            (rfu::RFU_STATUS_GET, false) => Service::RfuStatus(rfu::Status {
+                campaign: get(&rf::STATUS_CAMPAIGN, d),
+                state: get(&rf::STATE, d),
+                reason: get(&rf::REASON, d),
+                received: get_u32(&rf::RECEIVED, d) as u16,
+                bitmap: d[5..].to_vec(),
+            }),
+            (rfu::RFU_ABORT, _) => Service::RfuAbort {
+                campaign: get(&rf::CAMPAIGN, d),
+            },
             _ => Service::Raw {
                 command,
                 data: d.to_vec(),
@@ -575,6 +659,11 @@ impl Service {
             Discover { .. } | DiscoverReply(_) => 0x0b,
             SnSet(_) => 0x0f,
             SnGet | Sn(_) => 0x10,
+            RfuHeader(_) => 0x0c,
+            RfuData { .. } => 0x0d,
+            RfuSwap { .. } => 0x0e,
+            RfuStatusGet { .. } | RfuStatus(_) => rfu::RFU_STATUS_GET,
+            RfuAbort { .. } => rfu::RFU_ABORT,
             Raw { command, .. } => *command,
         }
     }
@@ -596,6 +685,7 @@ impl Service {
                 | IoConfig(_)
                 | DiscoverReply(_)
                 | Sn(_)
+                | RfuStatus(_)
         )
     }
 
@@ -626,6 +716,32 @@ impl Service {
                 r.stack.minor,
                 r.snr,
             ]),
+            RfuHeader(h) => {
+                out.push(h.campaign);
+                out.extend_from_slice(&h.size.to_be_bytes());
+                out.extend_from_slice(&[h.version.major, h.version.minor]);
+                out.extend_from_slice(&h.crc.to_be_bytes());
+                out.push(h.segment);
+            }
+            RfuData {
+                campaign,
+                segment,
+                data,
+            } => {
+                out.push(*campaign);
+                out.extend_from_slice(&segment.to_be_bytes());
+                out.extend_from_slice(data);
+            }
+            RfuSwap { campaign, crc } => {
+                out.push(*campaign);
+                out.extend_from_slice(&crc.to_be_bytes());
+            }
+            RfuStatusGet { campaign } | RfuAbort { campaign } => out.push(*campaign),
+            RfuStatus(s) => {
+                out.extend_from_slice(&[s.campaign, s.state, s.reason]);
+                out.extend_from_slice(&s.received.to_be_bytes());
+                out.extend_from_slice(&s.bitmap);
+            }
             Raw { data, .. } => out.extend_from_slice(data),
         }
         out
@@ -667,6 +783,18 @@ impl Service {
                     reply: None,
                     got: data.len(),
                 });
+            }
+        }
+        if let Service::RfuData { data: segment, .. } = self {
+            if !(1..=rfu::SEGMENT).contains(&segment.len()) {
+                return Err(ServiceError::Field(FieldError {
+                    field: "data",
+                    reason: alloc::format!(
+                        "a segment carries 1 to {} bytes, not {}",
+                        rfu::SEGMENT,
+                        segment.len()
+                    ),
+                }));
             }
         }
         field::validate(self.layout(), data).map_err(ServiceError::Field)
