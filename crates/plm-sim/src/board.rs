@@ -16,6 +16,7 @@
 //! line frames for it come back on the USART with the sender's address.
 
 use crate::ballast::{BallastConfig, HidBallast, Reply};
+use crate::rfu::{self, RfuManager};
 use crate::rng::Rng;
 use plm_core::app::concentrator::USART_IDLE;
 use plm_core::app::hid::{self, Hid};
@@ -32,7 +33,8 @@ use std::collections::VecDeque;
 /// The first board address of a simulated street: ST's OUI 00-80-E1, then
 /// the node number (the concentrator is node 0).
 pub const ADDRESS_BASE: u64 = 0x0080_E100_0000;
-/// Firmware release of the simulated boards' application.
+/// Firmware release of the simulated boards' application as they leave
+/// the factory (a remote firmware update changes it, [`crate::rfu`]).
 pub const FIRMWARE: Release = Release { major: 1, minor: 4 };
 /// Release of their ST7580 data link stack.
 pub const STACK: Release = Release { major: 2, minor: 0 };
@@ -97,6 +99,8 @@ pub struct Board {
     /// When the last USART byte of an incomplete frame came.
     usart_last: Option<Instant>,
     usart_out: VecDeque<Vec<u8>>,
+    /// Remote firmware update, with the board's flash.
+    rfu: RfuManager,
     /// Frames handled (for tests and views).
     pub handled: u64,
 }
@@ -129,8 +133,31 @@ impl Board {
             usart: None,
             usart_last: None,
             usart_out: VecDeque::new(),
+            rfu: RfuManager::factory(now, FIRMWARE),
             handled: 0,
         }
+    }
+
+    /// The release of the firmware that runs (service 06h).
+    pub fn firmware(&self) -> Release {
+        self.rfu.version()
+    }
+
+    /// Its RFU manager and flash (tests, faults).
+    pub fn rfu_mut(&mut self) -> &mut RfuManager {
+        &mut self.rfu
+    }
+
+    /// The board restarted (after a swap, or its watchdog): what its RAM
+    /// held is gone; its modem, a separate chip, keeps going.
+    fn restarted(&mut self) {
+        self.io_config = 0;
+        self.outputs = 0;
+        self.discovery_session = None;
+        self.discovery_acked = None;
+        self.discovery_reply = None;
+        self.mib_asks.clear();
+        self.hid_answers.clear();
     }
 
     /// The same board with a USART to the outside host (a concentrator).
@@ -190,11 +217,15 @@ impl Board {
             self.discovery_reply.map(|r| r.0),
         );
         let t = earliest(t, self.hid_answers.front().map(|a| a.0));
+        let t = earliest(t, self.rfu.poll_timeout());
         earliest(t, self.usart_last.map(|t| t + USART_IDLE))
     }
 
     /// Runs what is due.
     pub fn handle_timeout(&mut self, now: Instant, rng: &mut Rng) {
+        if self.rfu.poll_timeout().is_some_and(|t| t <= now) && self.rfu.handle_timeout(now) {
+            self.restarted();
+        }
         if self.engine.poll_timeout().is_some_and(|t| t <= now) {
             self.engine.handle_timeout(now);
         }
@@ -213,7 +244,7 @@ impl Board {
             if at <= now {
                 self.discovery_reply = None;
                 let reply = Service::DiscoverReply(Discovered {
-                    firmware: FIRMWARE,
+                    firmware: self.rfu.version(),
                     stack: STACK,
                     snr: self.last_snr,
                 });
@@ -373,6 +404,17 @@ impl Board {
         s: &Service,
         rng: &mut Rng,
     ) -> Option<Message> {
+        // Remote firmware update: the manager checks its own requests and
+        // keeps why it refused one for RFU_STATUS_GET.
+        if let Some(a) = self.rfu.handle(now, s, rng) {
+            return match a {
+                _ if broadcast => None,
+                rfu::Answer::Ack => Some(Message::Service(s.clone()).ack()),
+                rfu::Answer::Refused => Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR)),
+                rfu::Answer::Reply(r) => Some(Message::Service(r)),
+                rfu::Answer::Nothing => None,
+            };
+        }
         if s.validate().is_err() {
             let code = match s {
                 Service::ClockSet(_) => ErrorCode::RTC_ERROR,
@@ -410,7 +452,7 @@ impl Board {
                 ack
             }
             Service::FwRelGet => reply(Service::FwRel {
-                firmware: FIRMWARE,
+                firmware: self.rfu.version(),
                 stack: STACK,
             }),
             Service::ClockSet(c) => {
@@ -440,8 +482,7 @@ impl Board {
             }
             Service::SnGet => reply(Service::Sn(self.last_snr)),
             _ if broadcast => None,
-            // Replies and commands this firmware does not implement (RFU
-            // comes with the update protocol).
+            // Replies, and user commands this firmware does not know.
             _ => Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR)),
         }
     }

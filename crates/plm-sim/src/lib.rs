@@ -33,6 +33,7 @@ pub mod echo;
 pub mod flash;
 pub mod line;
 pub mod modem;
+pub mod rfu;
 pub mod rng;
 pub mod sim;
 pub mod street;

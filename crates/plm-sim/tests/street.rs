@@ -164,3 +164,72 @@ fn faults_lose_no_acknowledged_command() {
         assert!(acked > 40, "{via:?}: {acked} acknowledged, {failed} failed");
     }
 }
+
+/// Remote firmware update of one lamp over the power line, through the
+/// concentrator board: header, segments (one held back), the status
+/// naming what is missing, the swap, and the new release reported once
+/// the board has restarted; its neighbour keeps the old one.
+#[test]
+fn one_lamp_is_updated_over_the_line() {
+    use plm_core::app::rfu::{self, Header, RfuState, SEGMENT};
+    use plm_core::app::Release;
+    use plm_sim::rfu::{firmware_image, CONFIRM_AFTER, SWAP_RESET};
+
+    let mut d = street(3, Attach::Board, 11);
+    let lamp = street_address(2);
+    let new = Release { major: 1, minor: 5 };
+    let image = firmware_image(new, 2_000);
+    let h = Header::of(1, new, &image);
+    let ack = |s: &Service| Message::Service(s.clone()).ack();
+    let header = Service::RfuHeader(h);
+    assert_eq!(
+        d.ask(lamp, Message::Service(header.clone()), 30 * S),
+        Ok(ack(&header))
+    );
+
+    let segment = |n: usize| Service::RfuData {
+        campaign: 1,
+        segment: n as u16,
+        data: image[n * SEGMENT..((n + 1) * SEGMENT).min(image.len())].to_vec(),
+    };
+    let status = |d: &mut StreetDriver| match d.ask(
+        lamp,
+        Message::Service(Service::RfuStatusGet { campaign: 1 }),
+        30 * S,
+    ) {
+        Ok(Message::Service(Service::RfuStatus(s))) => s,
+        other => panic!("{other:?}"),
+    };
+    for n in (0..h.segments()).filter(|n| *n != 5) {
+        d.send(Message::Service(segment(n)).to(lamp));
+        d.run_for(250 * MS);
+    }
+    let missing: Vec<usize> = status(&mut d).missing(h.segments()).collect();
+    assert!(missing.contains(&5), "{missing:?}");
+    for n in missing {
+        d.send(Message::Service(segment(n)).to(lamp));
+        d.run_for(250 * MS);
+    }
+    assert_eq!(status(&mut d).state(), Some(RfuState::Complete));
+
+    let swap = Service::RfuSwap {
+        campaign: 1,
+        crc: rfu::image_crc(&image),
+    };
+    assert_eq!(
+        d.ask(lamp, Message::Service(swap.clone()), 30 * S),
+        Ok(ack(&swap))
+    );
+    d.run_for(SWAP_RESET + CONFIRM_AFTER + S);
+    let release = |d: &mut StreetDriver, node: usize| match d.ask(
+        street_address(node),
+        Message::Service(Service::FwRelGet),
+        30 * S,
+    ) {
+        Ok(Message::Service(Service::FwRel { firmware, .. })) => firmware,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(release(&mut d, 2), new);
+    assert_eq!(release(&mut d, 1), plm_sim::board::FIRMWARE);
+    assert_eq!(status(&mut d).state(), Some(RfuState::Done));
+}
