@@ -148,6 +148,14 @@ impl Board {
         &mut self.rfu
     }
 
+    /// Its supply came back at `now`: the bootloader starts an image
+    /// (the flash's power went with the supply: a write under way was
+    /// torn), and the firmware starts with nothing in RAM.
+    pub fn power_cycle(&mut self, now: Instant) {
+        self.rfu.power_cycle(now);
+        self.restarted();
+    }
+
     /// The board restarted (after a swap, or its watchdog): what its RAM
     /// held is gone; its modem, a separate chip, keeps going.
     fn restarted(&mut self) {

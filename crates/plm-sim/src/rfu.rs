@@ -180,7 +180,9 @@ impl RfuManager {
     /// The board resets at `now` (watchdog, or after a swap): as a power
     /// cycle, but a flash whose power went stays without.
     pub fn reset(&mut self, now: Instant) {
-        let done = self.done;
+        // A campaign under way is lost with the RAM: "done" no longer
+        // describes the campaign the status reports on.
+        let done = self.done.filter(|_| self.campaign.is_none());
         let last = self.last;
         *self = RfuManager::start(now, self.flash.clone());
         // What the board reports survives in its flash (model): the

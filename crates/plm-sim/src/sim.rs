@@ -443,10 +443,17 @@ impl Sim {
     }
 
     /// Cuts `node` off the line, or joins it again: a board whose supply
-    /// is off neither hears nor answers (an unreachable node).
+    /// is off neither hears nor answers (an unreachable node), and when it
+    /// comes back its firmware starts again (RAM lost, the bootloader
+    /// choosing the image, `Board::power_cycle`).
     pub fn set_cut(&mut self, node: usize, cut: bool) {
-        if let Some(n) = self.nodes.get_mut(node) {
-            n.cut = cut;
+        let Some(n) = self.nodes.get_mut(node) else {
+            return;
+        };
+        let restored = n.cut && !cut;
+        n.cut = cut;
+        if restored {
+            self.with_board(node, |b, now| b.power_cycle(now));
         }
     }
 

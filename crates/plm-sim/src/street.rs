@@ -56,6 +56,11 @@ impl StreetDriver {
         id
     }
 
+    /// The simulated world, to act on it (cut a board's supply, ...).
+    pub fn sim_mut(&mut self) -> &mut Sim {
+        &mut self.sim
+    }
+
     /// Sends a frame without waiting for anything.
     pub fn send(&mut self, frame: plm_core::app::AppFrame) {
         let now = self.sim.now();

@@ -232,4 +232,60 @@ fn one_lamp_is_updated_over_the_line() {
     assert_eq!(release(&mut d, 2), new);
     assert_eq!(release(&mut d, 1), plm_sim::board::FIRMWARE);
     assert_eq!(status(&mut d).state(), Some(RfuState::Done));
+
+    // A second update, cut off by a supply cut halfway: the board comes
+    // back on the release it ran, with no campaign, and takes the update
+    // again from its header.
+    let newer = Release { major: 1, minor: 6 };
+    let image = firmware_image(newer, 1_500);
+    let h = Header::of(2, newer, &image);
+    let header = Service::RfuHeader(h);
+    assert_eq!(
+        d.ask(lamp, Message::Service(header.clone()), 30 * S),
+        Ok(ack(&header))
+    );
+    let segment = |n: usize| Service::RfuData {
+        campaign: 2,
+        segment: n as u16,
+        data: image[n * SEGMENT..((n + 1) * SEGMENT).min(image.len())].to_vec(),
+    };
+    for n in 0..h.segments() / 2 {
+        d.send(Message::Service(segment(n)).to(lamp));
+        d.run_for(250 * MS);
+    }
+    d.sim_mut().set_cut(2, true);
+    d.run_for(2 * S);
+    d.sim_mut().set_cut(2, false);
+    d.run_for(2 * S);
+    assert_eq!(release(&mut d, 2), new);
+    let s = match d.ask(
+        lamp,
+        Message::Service(Service::RfuStatusGet { campaign: 2 }),
+        30 * S,
+    ) {
+        Ok(Message::Service(Service::RfuStatus(s))) => s,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        (s.campaign, s.state(), s.received),
+        (2, Some(RfuState::Idle), 0)
+    );
+    assert_eq!(
+        d.ask(lamp, Message::Service(header.clone()), 30 * S),
+        Ok(ack(&header))
+    );
+    for n in 0..h.segments() {
+        d.send(Message::Service(segment(n)).to(lamp));
+        d.run_for(250 * MS);
+    }
+    let swap = Service::RfuSwap {
+        campaign: 2,
+        crc: h.crc,
+    };
+    assert_eq!(
+        d.ask(lamp, Message::Service(swap.clone()), 30 * S),
+        Ok(ack(&swap))
+    );
+    d.run_for(SWAP_RESET + CONFIRM_AFTER + S);
+    assert_eq!(release(&mut d, 2), newer);
 }

@@ -51,9 +51,12 @@ pub fn describe_line_event(e: &LineEvent) -> String {
 /// The view.
 #[component]
 pub fn SimulatorView() -> impl IntoView {
+    let profile = use_console().profile;
     view! {
         <div class="cards">
-            <TopologyCard/>
+            // Echoing peers belong to the bare-modem world; a street has
+            // its own card.
+            {move || (!profile.get().is_street()).then(|| view! { <TopologyCard/> })}
             <StreetCard/>
             <ModemFaultsCard/>
             <LineCard/>
