@@ -306,6 +306,15 @@ impl RfuManager {
     }
 
     fn swap(&mut self, now: Instant, campaign: u8, crc: u32) -> Answer {
+        // Swapped already, the ACK lost and the swap asked again (before
+        // the restart, or after it with the new image running): the same
+        // answer again.
+        if self.last == (campaign, RfuReason::None)
+            && (self.reset_at.is_some() || self.running.record.crc == crc)
+            && self.campaign.is_none()
+        {
+            return Answer::Ack;
+        }
         let Some(c) = self
             .campaign
             .as_ref()
@@ -329,6 +338,8 @@ impl RfuManager {
             trial: true,
         });
         self.reset_at = Some(now + SWAP_RESET);
+        self.last = (campaign, RfuReason::None);
+        self.campaign = None;
         Answer::Ack
     }
 

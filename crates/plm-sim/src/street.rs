@@ -11,7 +11,7 @@ use plm_core::app::{
 };
 use plm_core::link::host::Transmit;
 use plm_core::st7580::TxParams;
-use plm_core::time::{earliest, Duration, Instant};
+use plm_core::time::{earliest, Duration, Instant, MS};
 use std::collections::BTreeMap;
 
 /// A concentrator driving a simulated street.
@@ -142,6 +142,31 @@ impl StreetDriver {
             Some(AppEvent::Answered { answer, .. }) => Ok(answer),
             Some(AppEvent::Failed { reason, .. }) => Err(reason),
             other => Err(format!("no answer within the time allowed ({other:?})")),
+        }
+    }
+
+    /// Runs a firmware update campaign to its end: every request the
+    /// engine hands out goes through the concentrator, its answer (or
+    /// failure) back to the engine.
+    pub fn update(&mut self, u: &mut plm_core::app::update::Update) {
+        while !u.is_done() {
+            let now = self.sim.now();
+            match u.poll(now) {
+                Some(request) => match self.request(request, 120 * 1_000 * MS) {
+                    Some(AppEvent::Answered { answer, .. }) => {
+                        u.on_answer(self.sim.now(), Ok(answer))
+                    }
+                    Some(AppEvent::Failed { reason, .. }) => {
+                        u.on_answer(self.sim.now(), Err(reason))
+                    }
+                    Some(_) => {}
+                    None => u.on_answer(self.sim.now(), Err("no answer within 2 minutes".into())),
+                },
+                None => {
+                    let until = u.poll_timeout().unwrap_or(now + 100 * MS);
+                    self.run_for(until.saturating_sub(now).max(1));
+                }
+            }
         }
     }
 

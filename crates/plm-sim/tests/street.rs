@@ -289,3 +289,47 @@ fn one_lamp_is_updated_over_the_line() {
     d.run_for(SWAP_RESET + CONFIRM_AFTER + S);
     assert_eq!(release(&mut d, 2), newer);
 }
+
+/// The update engine puts a new release on a whole street (segments
+/// broadcast, then each board's missing ones repaired, swaps one by one),
+/// on a line that loses frames; an image that does not start is reported
+/// per board in words, and the boards keep their release.
+#[test]
+fn a_street_is_updated_by_the_engine() {
+    use plm_core::app::update::{BoardState, Update, UpdateConfig};
+    use plm_core::app::Release;
+    use plm_sim::rfu::firmware_image;
+
+    let mut d = street(5, Attach::Board, 13);
+    let line = LineConfig {
+        loss: 0.1,
+        ..d.sim_mut().line().clone()
+    };
+    d.sim_mut().set_line(line);
+    let targets: Vec<_> = (1..=5).map(street_address).collect();
+    let new = Release { major: 1, minor: 5 };
+    let mut u = Update::new(
+        3,
+        new,
+        firmware_image(new, 4_000),
+        &targets,
+        UpdateConfig::default(),
+    )
+    .unwrap();
+    let start = d.now();
+    d.update(&mut u);
+    let took = (d.now() - start) as f64 / 1e6;
+    for (a, s) in u.boards() {
+        assert_eq!(*s, BoardState::Done, "{a}: {:?}", u.report());
+    }
+    assert!(took < 120.0, "{took:.1} s");
+
+    // An image without the firmware's mark: every board goes back.
+    let bad: Vec<u8> = (0..3_000u32).map(|i| (i * 7) as u8).collect();
+    let newer = Release { major: 1, minor: 6 };
+    let mut u = Update::new(4, newer, bad, &targets[..2], UpdateConfig::default()).unwrap();
+    d.update(&mut u);
+    for (a, words) in u.report() {
+        assert!(words.contains("came back on release 1.5"), "{a}: {words}");
+    }
+}

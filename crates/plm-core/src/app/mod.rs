@@ -12,7 +12,8 @@
 //! - [`usart`]: the USART stream decoder; [`requester`]: requests and
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
 //!   USART or a bare ST7580; [`discovery`]: finding the boards on a line.
-//! - [`rfu`]: remote firmware update, the layouts of its commands.
+//! - [`rfu`]: remote firmware update, the layouts of its commands;
+//!   [`update`]: the engine that updates one board or a street.
 //!
 //! Decisions where the seed is silent are in docs/protocol-notes.md
 //! ("STEVAL-IHP007V1 application layer").
@@ -28,6 +29,7 @@ pub mod message;
 pub mod requester;
 pub mod rfu;
 pub mod service;
+pub mod update;
 pub mod usart;
 
 pub use concentrator::{Carrier, Concentrator, Happening};
