@@ -6,7 +6,96 @@
 
 use plm_core::field::{Field, Kind};
 use plm_core::mib::Object;
-use std::collections::BTreeMap;
+
+/// Texts by field name: what a form's inputs hold, or what is wrong with
+/// each. A list (an object has a handful of fields): a map type of its
+/// own would bring its own copy of the tree code into the console's wasm.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Texts(Vec<(&'static str, String)>);
+
+impl Texts {
+    /// The text of field `name`.
+    pub fn get(&self, name: &str) -> Option<&String> {
+        self.0.iter().find(|(n, _)| *n == name).map(|(_, t)| t)
+    }
+
+    /// Sets the text of field `name`.
+    pub fn insert(&mut self, name: &'static str, text: String) {
+        match self.0.iter_mut().find(|(n, _)| *n == name) {
+            Some(entry) => entry.1 = text,
+            None => self.0.push((name, text)),
+        }
+    }
+
+    /// Whether field `name` has a text.
+    pub fn contains_key(&self, name: &str) -> bool {
+        self.get(name).is_some()
+    }
+
+    /// Fields with a text.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Whether no field has a text.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+/// MIB values read from the modem, by object index (a list by index, for
+/// the same reason as [`Texts`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MibValues(Vec<Option<Vec<u8>>>);
+
+impl MibValues {
+    /// The value of object `index`, if read.
+    pub fn get(&self, index: &u8) -> Option<&Vec<u8>> {
+        self.0.get(*index as usize).and_then(Option::as_ref)
+    }
+
+    /// Keeps the value of object `index`.
+    pub fn insert(&mut self, index: u8, value: Vec<u8>) {
+        let i = index as usize;
+        if self.0.len() <= i {
+            self.0.resize(i + 1, None);
+        }
+        self.0[i] = Some(value);
+    }
+
+    /// Whether object `index` was read.
+    pub fn contains_key(&self, index: &u8) -> bool {
+        self.get(index).is_some()
+    }
+}
+
+impl std::ops::Index<&u8> for MibValues {
+    type Output = Vec<u8>;
+
+    /// The value of object `index`; panics if it was not read (tests).
+    fn index(&self, index: &u8) -> &Vec<u8> {
+        self.get(index).expect("a value for this object")
+    }
+}
+
+impl std::ops::Index<&str> for Texts {
+    type Output = String;
+
+    /// The text of field `name`; panics if it has none (tests).
+    fn index(&self, name: &str) -> &String {
+        self.get(name).expect("a text for this field")
+    }
+}
+
+impl FromIterator<(&'static str, String)> for Texts {
+    fn from_iter<I: IntoIterator<Item = (&'static str, String)>>(it: I) -> Self {
+        let mut t = Texts::default();
+        for (n, v) in it {
+            t.insert(n, v);
+        }
+        t
+    }
+}
 
 /// The text an input shows for a field of `data`: numbers in decimal,
 /// enums and flags as their raw value, bytes as hex.
@@ -48,7 +137,7 @@ pub fn differences(object: &'static Object, a: &[u8], b: &[u8]) -> Vec<&'static 
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Problems {
     /// Field name to the reason, in words.
-    pub fields: BTreeMap<&'static str, String>,
+    pub fields: Texts,
     /// A reason that is no one field's (length, reserved bits of the base).
     pub object: Option<String>,
 }
@@ -97,11 +186,7 @@ fn apply(field: &Field, text: &str, data: &mut [u8]) -> Result<(), String> {
 /// default) with every input applied. Reserved bits keep the base's.
 /// Every field's problem is reported, not only the first, and the whole
 /// value is then checked as a MIB_WriteRequest would be.
-pub fn build(
-    object: &'static Object,
-    base: &[u8],
-    inputs: &BTreeMap<&'static str, String>,
-) -> Result<Vec<u8>, Problems> {
+pub fn build(object: &'static Object, base: &[u8], inputs: &Texts) -> Result<Vec<u8>, Problems> {
     let mut data = base.to_vec();
     data.resize(object.len, 0);
     let mut problems = Problems::default();
@@ -136,7 +221,7 @@ pub const PROFILE_FORMAT: &str = "plm-console MIB profile";
 /// A configuration profile: values of writable MIB objects, saved to and
 /// loaded from a JSON file (`{"format":…, "chip":"ST7580", "objects":
 /// {"01": "014ff0…"}}`, values as lowercase hex).
-pub fn profile_json(values: &BTreeMap<u8, Vec<u8>>) -> String {
+pub fn profile_json(values: &MibValues) -> String {
     let mut objects = serde_json::Map::new();
     for o in plm_core::mib::ST7580.iter().filter(|o| o.access.write) {
         if let Some(v) = values.get(&(o.index as u8)) {
@@ -193,7 +278,7 @@ mod tests {
     use super::*;
     use plm_core::st7580::mib::{index, object, phy_config};
 
-    fn inputs(object: &'static Object, data: &[u8]) -> BTreeMap<&'static str, String> {
+    fn inputs(object: &'static Object, data: &[u8]) -> Texts {
         editable(object)
             .map(|f| (f.name, input_text(f, data)))
             .collect()
@@ -258,7 +343,7 @@ mod tests {
 
     #[test]
     fn profiles_save_writable_objects_and_load_them_checked() {
-        let mut values = BTreeMap::new();
+        let mut values = MibValues::default();
         values.insert(
             index::PHY_CONFIG,
             object(index::PHY_CONFIG).unwrap().default.to_vec(),

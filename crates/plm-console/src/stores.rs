@@ -62,7 +62,7 @@ pub struct ModemStore {
     /// The last BIO_ResetIndication's ResetData and when it came.
     pub last_reset: RwSignal<Option<(Instant, u8)>>,
     /// The value of each MIB object as last read or written.
-    pub mib: RwSignal<BTreeMap<u8, Vec<u8>>>,
+    pub mib: RwSignal<crate::mibform::MibValues>,
 }
 
 /// The Simulator view's state.
@@ -200,7 +200,7 @@ pub fn provide_console() -> Console {
         modem: ModemStore {
             status: RwSignal::new(None),
             last_reset: RwSignal::new(None),
-            mib: RwSignal::new(BTreeMap::new()),
+            mib: RwSignal::new(Default::default()),
         },
         sim: SimStore {
             nodes: RwSignal::new(1),
@@ -322,7 +322,7 @@ impl Console {
                 .replace_transport(Some(transport));
         }
         self.street.version.update(|v| *v += 1);
-        self.modem.mib.set(BTreeMap::new());
+        self.modem.mib.set(Default::default());
         self.modem.status.set(None);
         self.conn.retries.set(0);
         self.conn.last_problem.set(None);

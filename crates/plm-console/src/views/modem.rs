@@ -14,10 +14,9 @@ use plm_core::field::{Field, Kind};
 use plm_core::mib::Object;
 use plm_core::st7580::mib::index;
 use plm_core::st7580::Command;
-use std::collections::BTreeMap;
 use std::rc::Rc;
 
-type Inputs = BTreeMap<&'static str, String>;
+type Inputs = mibform::Texts;
 
 fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
     mibform::editable(object)
