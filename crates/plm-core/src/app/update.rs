@@ -70,6 +70,9 @@ pub enum BoardState {
     Restarting(Instant),
     /// It runs the new release.
     Done,
+    /// The campaign was aborted before its swap: it keeps its release and
+    /// forgot the segments (RFU_ABORT acknowledged).
+    Aborted,
     /// Given up, and why, in words.
     Failed(String),
 }
@@ -81,6 +84,8 @@ enum Phase {
     Broadcast(usize),
     Repair,
     Swap,
+    /// Telling the boards not swapped yet to forget the campaign.
+    Abort,
     Over,
 }
 
@@ -284,8 +289,41 @@ impl Update {
                         None => self.phase = Phase::Over,
                     }
                 }
+                Phase::Abort => {
+                    let pending = self.first(|s| {
+                        matches!(
+                            s,
+                            BoardState::Announcing
+                                | BoardState::Receiving { .. }
+                                | BoardState::Complete
+                        )
+                    });
+                    if let Some(b) = pending {
+                        let campaign = self.header.campaign;
+                        return self.ask(b, Service::RfuAbort { campaign });
+                    }
+                    // Boards swapped already finish as they would.
+                    self.phase = if self
+                        .first(|s| matches!(s, BoardState::Restarting(_)))
+                        .is_some()
+                    {
+                        Phase::Swap
+                    } else {
+                        Phase::Over
+                    };
+                }
                 Phase::Over => return None,
             }
+        }
+    }
+
+    /// Stops the campaign: every board not swapped yet is told to forget
+    /// it (RFU_ABORT) and keeps its release; a board already swapped
+    /// finishes (its image runs). The answer to a request under way still
+    /// comes to [`Update::on_answer`].
+    pub fn abort(&mut self) {
+        if self.phase != Phase::Over {
+            self.phase = Phase::Abort;
         }
     }
 
@@ -297,6 +335,20 @@ impl Update {
         };
         self.waiting = Waiting::Nothing;
         let state = core::mem::replace(&mut self.boards[b].1, BoardState::Announcing);
+        if self.phase == Phase::Abort
+            && !matches!(state, BoardState::Restarting(_) | BoardState::Done)
+        {
+            self.boards[b].1 = match answer {
+                Ok(Message::Ack { .. }) => BoardState::Aborted,
+                // Not told: it forgets the campaign at its next restart,
+                // and never swaps without being asked.
+                Ok(_) | Err(_) => BoardState::Failed(
+                    "aborted; it did not confirm (it forgets the segments at its next restart)"
+                        .into(),
+                ),
+            };
+            return;
+        }
         self.boards[b].1 = match (state, answer) {
             (_, Err(why)) => BoardState::Failed(format!("did not answer: {why}")),
             (BoardState::Announcing, Ok(Message::Ack { .. })) => BoardState::Receiving {
@@ -361,6 +413,7 @@ impl Update {
             .map(|(a, s)| {
                 let words = match s {
                     BoardState::Done => format!("updated to {}", self.header.version),
+                    BoardState::Aborted => "not updated: the update was aborted".into(),
                     BoardState::Failed(why) => format!("not updated: {why}"),
                     other => format!("in progress ({other:?})"),
                 };
@@ -482,6 +535,41 @@ mod tests {
         assert_eq!(u.poll(t), None);
         assert!(u.is_done());
         assert_eq!(u.report()[0].1, "updated to 2.1");
+    }
+
+    #[test]
+    fn an_abort_tells_the_boards_not_swapped_to_forget_the_campaign() {
+        let a2 = Address::from_u64(0x0080_E100_0008);
+        let mut u = Update::new(
+            1,
+            NEW,
+            vec![1; 100],
+            &[board(), a2],
+            UpdateConfig::default(),
+        )
+        .unwrap();
+        u.poll(0).unwrap();
+        u.on_answer(0, ack(0x0c));
+        u.poll(0).unwrap();
+        u.on_answer(0, ack(0x0c));
+        let r = u.poll(0).unwrap();
+        assert!(matches!(
+            r.message,
+            Message::Service(Service::RfuData { .. })
+        ));
+        u.abort();
+        for _ in 0..2 {
+            let r = u.poll(1_000_000).unwrap();
+            assert_eq!(
+                r.message,
+                Message::Service(Service::RfuAbort { campaign: 1 })
+            );
+            u.on_answer(1_000_000, ack(0x12));
+        }
+        assert_eq!(u.poll(1_000_000), None);
+        assert!(u.is_done());
+        assert!(u.boards().iter().all(|(_, s)| *s == BoardState::Aborted));
+        assert_eq!(u.report()[1].1, "not updated: the update was aborted");
     }
 
     #[test]
