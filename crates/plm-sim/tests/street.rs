@@ -165,13 +165,22 @@ fn faults_lose_no_acknowledged_command() {
     }
 }
 
+/// SERVICE_RFU_SET_IMG_DATA with segment `n` of `image`.
+fn rfu_segment(campaign: u8, image: &[u8], n: usize) -> Service {
+    Service::RfuData {
+        campaign,
+        segment: n as u16,
+        data: plm_core::app::rfu::segment_of(image, n).to_vec(),
+    }
+}
+
 /// Remote firmware update of one lamp over the power line, through the
 /// concentrator board: header, segments (one held back), the status
 /// naming what is missing, the swap, and the new release reported once
 /// the board has restarted; its neighbour keeps the old one.
 #[test]
 fn one_lamp_is_updated_over_the_line() {
-    use plm_core::app::rfu::{self, Header, RfuState, SEGMENT};
+    use plm_core::app::rfu::{self, Header, RfuState};
     use plm_core::app::Release;
     use plm_sim::rfu::{firmware_image, CONFIRM_AFTER, SWAP_RESET};
 
@@ -187,11 +196,7 @@ fn one_lamp_is_updated_over_the_line() {
         Ok(ack(&header))
     );
 
-    let segment = |n: usize| Service::RfuData {
-        campaign: 1,
-        segment: n as u16,
-        data: image[n * SEGMENT..((n + 1) * SEGMENT).min(image.len())].to_vec(),
-    };
+    let segment = |n: usize| rfu_segment(1, &image, n);
     let status = |d: &mut StreetDriver| match d.ask(
         lamp,
         Message::Service(Service::RfuStatusGet { campaign: 1 }),
@@ -244,11 +249,7 @@ fn one_lamp_is_updated_over_the_line() {
         d.ask(lamp, Message::Service(header.clone()), 30 * S),
         Ok(ack(&header))
     );
-    let segment = |n: usize| Service::RfuData {
-        campaign: 2,
-        segment: n as u16,
-        data: image[n * SEGMENT..((n + 1) * SEGMENT).min(image.len())].to_vec(),
-    };
+    let segment = |n: usize| rfu_segment(2, &image, n);
     for n in 0..h.segments() / 2 {
         d.send(Message::Service(segment(n)).to(lamp));
         d.run_for(250 * MS);

@@ -45,6 +45,12 @@ pub fn image_crc(image: &[u8]) -> u32 {
     CRC32.checksum(image)
 }
 
+/// Segment `n` of `image` (the last one short).
+pub fn segment_of(image: &[u8], n: usize) -> &[u8] {
+    let start = (n * SEGMENT).min(image.len());
+    &image[start..((n + 1) * SEGMENT).min(image.len())]
+}
+
 /// Segments an image of `size` bytes is cut into.
 pub fn segments(size: usize) -> usize {
     size.div_ceil(SEGMENT)

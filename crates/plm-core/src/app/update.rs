@@ -20,7 +20,7 @@
 use super::frame::Address;
 use super::message::Message;
 use super::requester::Request;
-use super::rfu::{self, Header, RfuState, Status, SEGMENT};
+use super::rfu::{self, Header, RfuState, Status};
 use super::service::{Release, Service};
 use crate::time::{Duration, Instant, MS};
 use alloc::format;
@@ -170,11 +170,10 @@ impl Update {
     }
 
     fn segment(&self, n: usize) -> Service {
-        let end = ((n + 1) * SEGMENT).min(self.image.len());
         Service::RfuData {
             campaign: self.header.campaign,
             segment: n as u16,
-            data: self.image[n * SEGMENT..end].to_vec(),
+            data: rfu::segment_of(&self.image, n).to_vec(),
         }
     }
 
@@ -435,6 +434,19 @@ mod tests {
         Address::from_u64(0x0080_E100_0007)
     }
 
+    /// Campaign 9's status with the first segments held as `bits` says.
+    fn held(state: RfuState, bits: u8) -> Status {
+        let mut bitmap = vec![0u8; rfu::BITMAP_LEN];
+        bitmap[0] = bits;
+        Status {
+            campaign: 9,
+            state: state.byte(),
+            reason: 0,
+            received: bits.count_ones() as u16,
+            bitmap,
+        }
+    }
+
     fn ack(code: u8) -> Result<Message, String> {
         Ok(Message::Ack {
             frame_type: FrameType::Service,
@@ -482,15 +494,7 @@ mod tests {
             r.message,
             Message::Service(Service::RfuStatusGet { campaign: 9 })
         ));
-        let mut bitmap = alloc::vec![0u8; rfu::BITMAP_LEN];
-        bitmap[0] = 0b101;
-        let status = Status {
-            campaign: 9,
-            state: RfuState::Receiving.byte(),
-            reason: 0,
-            received: 2,
-            bitmap,
-        };
+        let status = held(RfuState::Receiving, 0b101);
         u.on_answer(t, Ok(Message::Service(Service::RfuStatus(status))));
         let r = u.poll(t).unwrap();
         assert!(!r.broadcast);
@@ -504,15 +508,7 @@ mod tests {
             r.message,
             Message::Service(Service::RfuStatusGet { .. })
         ));
-        let mut bitmap = alloc::vec![0u8; rfu::BITMAP_LEN];
-        bitmap[0] = 0b111;
-        let status = Status {
-            campaign: 9,
-            state: RfuState::Complete.byte(),
-            reason: 0,
-            received: 3,
-            bitmap,
-        };
+        let status = held(RfuState::Complete, 0b111);
         u.on_answer(t, Ok(Message::Service(Service::RfuStatus(status))));
         let r = u.poll(t).unwrap();
         assert!(matches!(
