@@ -152,11 +152,7 @@ fn update(lamps: usize, size: usize) {
         Update::new(1, new, image.clone(), &targets, UpdateConfig::default()).expect("a campaign");
     d.update(&mut u);
     let street_s = (d.now() - start) as f64 / 1e6;
-    let done = u
-        .boards()
-        .iter()
-        .filter(|(_, s)| *s == BoardState::Done)
-        .count();
+    let done = u.boards().filter(|(_, s)| **s == BoardState::Done).count();
     let mut d = street(lamps);
     let start = d.now();
     let mut one_by_one_done = 0;
@@ -164,11 +160,7 @@ fn update(lamps: usize, size: usize) {
         let mut u =
             Update::new(1, new, image.clone(), &[*t], UpdateConfig::default()).expect("a campaign");
         d.update(&mut u);
-        one_by_one_done += u
-            .boards()
-            .iter()
-            .filter(|(_, s)| *s == BoardState::Done)
-            .count();
+        one_by_one_done += u.boards().filter(|(_, s)| **s == BoardState::Done).count();
     }
     let one_s = (d.now() - start) as f64 / 1e6;
     println!(

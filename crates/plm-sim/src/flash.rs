@@ -43,9 +43,7 @@ pub const BOOTLOADER: usize = 4 * 1024;
 pub const SLOT: usize = IMAGE_MAX;
 /// Flash address of the start of the flash (STM32F10x).
 pub const FLASH_BASE: u32 = 0x0800_0000;
-/// Bytes of the interrupt vector table at the start of an image
-/// (STM32F10x: 76 vectors after the initial stack pointer).
-pub const VECTORS: usize = 0x130;
+pub use plm_core::app::rfu::image::VECTORS;
 
 /// Flash address of slot `slot`'s first byte.
 pub fn slot_base(slot: usize) -> u32 {
@@ -483,6 +481,11 @@ mod tests {
                 ..b.record
             });
         }
+    }
+
+    #[test]
+    fn images_are_linked_for_slot_0() {
+        assert_eq!(slot_base(0), plm_core::app::rfu::image::LINK_BASE);
     }
 
     #[test]

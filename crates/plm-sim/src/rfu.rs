@@ -14,11 +14,12 @@
 //! - An image that comes up confirms itself [`CONFIRM_AFTER`] after its
 //!   start; one that does not resets [`FAIL_AFTER`] after it, and the
 //!   bootloader goes back to the old image. A simulated image "comes up"
-//!   when it is one [`firmware_image`] built (its mark after the vector
-//!   table names the release its header announced).
+//!   when its descriptor names the release its header announced
+//!   ([`firmware_image`] builds such images).
 
-use crate::flash::{Boot, Flash, Record, VECTORS};
+use crate::flash::{Boot, Flash, Record};
 use crate::rng::Rng;
+use plm_core::app::rfu::image::{self, VECTORS};
 use plm_core::app::rfu::{self, Header, RfuReason, RfuState, Status, BITMAP_LEN, SEGMENT};
 use plm_core::app::{Release, Service};
 use plm_core::time::{Duration, Instant, MS};
@@ -32,28 +33,26 @@ pub const CONFIRM_AFTER: Duration = 5_000 * MS;
 /// How long an image that does not come up lasts before the watchdog
 /// resets the board (model).
 pub const FAIL_AFTER: Duration = 2_000 * MS;
-/// What a simulated image carries after its vector table.
-const MARK: &[u8; 10] = b"PLM-SIM-FW";
 /// Bytes of the simulated boards' factory image.
 pub const FACTORY_SIZE: usize = 24 * 1024;
 
-/// A simulated firmware image of `size` bytes (at least the vector table
-/// and the mark) for release `version`: a stack pointer, vectors into
-/// slot 0, the mark and the release, then bytes that stand for code.
+/// A simulated firmware image of `size` bytes (at least a vector table and
+/// the descriptor) for release `version`: a stack pointer, vectors into
+/// slot 0, bytes that stand for code, sealed with its descriptor
+/// (`plm_core::app::rfu::image`), so that it passes the check the console
+/// and `plm board rfu` make.
 pub fn firmware_image(version: Release, size: usize) -> Vec<u8> {
-    let size = size.max(VECTORS + MARK.len() + 2);
-    let mut image: Vec<u8> = (0..size)
+    let size = size.clamp(image::IMAGE_MIN, rfu::IMAGE_MAX);
+    let mut bytes: Vec<u8> = (0..size)
         .map(|i| (i as u32).wrapping_mul(2_654_435_761).to_be_bytes()[0] ^ version.minor)
         .collect();
-    image[..4].copy_from_slice(&0x2000_5000u32.to_le_bytes());
+    bytes[..4].copy_from_slice(&0x2000_5000u32.to_le_bytes());
     for (n, at) in (4..VECTORS).step_by(4).enumerate() {
-        let v = crate::flash::slot_base(0) + 0x200 + 4 * n as u32 + 1;
-        image[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        let v = image::LINK_BASE + 0x200 + 4 * n as u32 + 1;
+        bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
     }
-    image[VECTORS..VECTORS + MARK.len()].copy_from_slice(MARK);
-    image[VECTORS + MARK.len()] = version.major;
-    image[VECTORS + MARK.len() + 1] = version.minor;
-    image
+    image::seal(&mut bytes, version);
+    bytes
 }
 
 /// The factory image of release `version`, shared by every board.
@@ -68,12 +67,12 @@ fn factory_image(version: Release) -> Arc<[u8]> {
     }
 }
 
-/// Whether the image `record` names comes up: a simulated image of the
-/// release its header announced.
+/// Whether the image `record` names comes up: its descriptor names the
+/// release its header announced (an image of another release, or none,
+/// stands for firmware that crashes at start).
 fn comes_up(flash: &Flash, record: &Record) -> bool {
-    let head = flash.image(record.slot as usize, VECTORS + MARK.len() + 2);
-    head[VECTORS..VECTORS + MARK.len()] == MARK[..]
-        && head[VECTORS + MARK.len()..] == [record.version.major, record.version.minor]
+    let head = flash.image(record.slot as usize, image::IMAGE_MIN);
+    image::release_of(&head) == Some(record.version)
 }
 
 /// A campaign under way.
@@ -326,7 +325,13 @@ impl RfuManager {
             return self.refuse(campaign, RfuReason::Missing);
         }
         let (slot, header) = (c.slot, c.header);
-        if crc != header.crc || self.flash.image_crc(slot, header.size as usize) != crc {
+        if crc != header.crc {
+            return self.refuse(campaign, RfuReason::Crc);
+        }
+        if self.flash.image_crc(slot, header.size as usize) != crc {
+            // What it holds will never check: forget it, so that the
+            // campaign's header starts it over (protocol-notes.md).
+            self.campaign = None;
             return self.refuse(campaign, RfuReason::Crc);
         }
         self.flash.write_record(Record {

@@ -19,6 +19,8 @@
 //! - Multi-byte numbers are big-endian, as the error frames' codes and the
 //!   frames' CRC.
 
+pub mod image;
+
 use super::service::Release;
 use crc::{Crc, CRC_32_ISO_HDLC};
 

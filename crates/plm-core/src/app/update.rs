@@ -12,10 +12,14 @@
 //! 4. **Swap**, one board at a time (ACK); then, once it had the time to
 //!    restart and confirm its image, its release is read back (06h).
 //!
-//! A board that does not answer (after the requester's retries) or
-//! refuses is left with its reason in words; the others go on. Every
-//! request goes through the caller's requester one at a time: the engine
-//! hands out the next one only when the last is over.
+//! A board that does not answer (after the requester's retries) is tried
+//! again later, [`UpdateConfig::backoff`] doubling each time, while the
+//! others go on; one that lost the campaign (it restarted) or refused its
+//! swap is announced again and repaired; past the limits it is left with
+//! its reason in words. Every request goes through the caller's requester
+//! one at a time: the engine hands out the next one only when the last is
+//! over. [`Update::save`] and [`Update::resume`] carry a campaign over a
+//! closed console or a pulled cable (`update/save.rs`).
 
 use super::frame::Address;
 use super::message::Message;
@@ -26,6 +30,8 @@ use crate::time::{Duration, Instant, MS};
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
+
+mod save;
 
 /// How the engine paces itself.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,6 +46,15 @@ pub struct UpdateConfig {
     /// From a swap's ACK to reading the release back: the board resets
     /// (300 ms) and its image confirms itself (5 s).
     pub restart: Duration,
+    /// After a board did not answer (the requester's own retries spent):
+    /// the wait before it is tried again, doubled each time.
+    pub backoff: Duration,
+    /// Times a board may stay silent, or refuse a header, before it is
+    /// given up.
+    pub silences: u8,
+    /// Times a board that lost the campaign or refused its swap is
+    /// announced again.
+    pub restarts: u8,
 }
 
 impl Default for UpdateConfig {
@@ -48,6 +63,9 @@ impl Default for UpdateConfig {
             gap: 250 * MS,
             repair_rounds: 5,
             restart: 8_000 * MS,
+            backoff: 15_000 * MS,
+            silences: 3,
+            restarts: 2,
         }
     }
 }
@@ -75,6 +93,26 @@ pub enum BoardState {
     Aborted,
     /// Given up, and why, in words.
     Failed(String),
+}
+
+impl BoardState {
+    /// Still to get segments (or its header).
+    fn receiving(&self) -> bool {
+        matches!(self, BoardState::Announcing | BoardState::Receiving { .. })
+    }
+}
+
+/// One board of a campaign.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Target {
+    address: Address,
+    state: BoardState,
+    /// Times it did not answer (or refused a header).
+    silences: u8,
+    /// Times it was announced again.
+    restarts: u8,
+    /// Not to be asked before this time (back-off).
+    not_before: Instant,
 }
 
 /// Where the campaign is.
@@ -105,9 +143,11 @@ pub struct Update {
     header: Header,
     image: Vec<u8>,
     config: UpdateConfig,
-    boards: Vec<(Address, BoardState)>,
+    targets: Vec<Target>,
     phase: Phase,
     waiting: Waiting,
+    /// Segment bytes handed out so far.
+    sent: u64,
 }
 
 impl Update {
@@ -136,12 +176,19 @@ impl Update {
             header: Header::of(campaign, version, &image),
             image,
             config,
-            boards: targets
+            targets: targets
                 .iter()
-                .map(|a| (*a, BoardState::Announcing))
+                .map(|a| Target {
+                    address: *a,
+                    state: BoardState::Announcing,
+                    silences: 0,
+                    restarts: 0,
+                    not_before: 0,
+                })
                 .collect(),
             phase: Phase::Announce,
             waiting: Waiting::Nothing,
+            sent: 0,
         })
     }
 
@@ -150,14 +197,77 @@ impl Update {
         self.header
     }
 
+    /// The image it sends.
+    pub fn image(&self) -> &[u8] {
+        &self.image
+    }
+
     /// Every board and where it is.
-    pub fn boards(&self) -> &[(Address, BoardState)] {
-        &self.boards
+    pub fn boards(&self) -> impl Iterator<Item = (Address, &BoardState)> + '_ {
+        self.targets.iter().map(|t| (t.address, &t.state))
     }
 
     /// Whether it is over (every board done or given up).
     pub fn is_done(&self) -> bool {
         self.phase == Phase::Over
+    }
+
+    /// Whether it is being aborted (or was).
+    pub fn is_aborting(&self) -> bool {
+        self.phase == Phase::Abort
+    }
+
+    /// Segment bytes handed out so far (since it started or resumed).
+    pub fn bytes_sent(&self) -> u64 {
+        self.sent
+    }
+
+    /// Of board `i`'s segments, how many it is known to hold, in
+    /// thousandths (segments broadcast so far while the broadcast runs).
+    pub fn permille(&self, i: usize) -> u16 {
+        let count = self.header.segments();
+        let held = match &self.targets[i].state {
+            BoardState::Announcing | BoardState::Aborted | BoardState::Failed(_) => 0,
+            BoardState::Receiving { missing, asked } => match self.phase {
+                Phase::Broadcast(n) => n,
+                _ if *asked == 0 && missing.is_empty() => count,
+                _ => count - missing.len().min(count),
+            },
+            _ => count,
+        };
+        (held * 1000 / count.max(1)) as u16
+    }
+
+    /// What is left, at the engine's own pace: the segments still to
+    /// broadcast or repair, a status per board still receiving, and a
+    /// swap and restart per board not swapped yet.
+    pub fn time_left(&self) -> Duration {
+        let broadcast = match self.phase {
+            Phase::Announce => self.header.segments(),
+            Phase::Broadcast(n) => self.header.segments() - n.min(self.header.segments()),
+            _ => 0,
+        };
+        let mut segments = broadcast as u64;
+        let mut asks = 0;
+        let mut swaps = 0;
+        for t in &self.targets {
+            match &t.state {
+                BoardState::Announcing => asks += 2,
+                BoardState::Receiving { missing, .. } => {
+                    segments += missing.len() as u64;
+                    asks += 1;
+                }
+                BoardState::Complete => swaps += 1,
+                _ => {}
+            }
+        }
+        let restarting = self
+            .targets
+            .iter()
+            .any(|t| matches!(t.state, BoardState::Restarting(_)));
+        segments * self.config.gap
+            + (asks + swaps) * 1_000 * MS
+            + (swaps + restarting as u64) * self.config.restart
     }
 
     /// When [`Update::poll`] may have something again, if it waits for
@@ -169,21 +279,40 @@ impl Update {
         }
     }
 
-    fn segment(&self, n: usize) -> Service {
+    fn segment(&mut self, n: usize) -> Service {
+        let data = rfu::segment_of(&self.image, n).to_vec();
+        self.sent += data.len() as u64;
         Service::RfuData {
             campaign: self.header.campaign,
             segment: n as u16,
-            data: rfu::segment_of(&self.image, n).to_vec(),
+            data,
         }
     }
 
-    fn first(&self, f: impl Fn(&BoardState) -> bool) -> Option<usize> {
-        self.boards.iter().position(|(_, s)| f(s))
+    /// The first board, ready at `now`, whose state `f` picks.
+    fn first<T>(&self, now: Instant, f: impl Fn(&BoardState) -> Option<T>) -> Option<(usize, T)> {
+        self.targets
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.not_before <= now)
+            .find_map(|(i, t)| f(&t.state).map(|x| (i, x)))
+    }
+
+    /// The earliest time a board that `f` picks but that is not ready yet
+    /// will be.
+    fn next_ready(&self, f: impl Fn(&BoardState) -> Option<Instant>) -> Option<Instant> {
+        self.targets
+            .iter()
+            .filter_map(|t| f(&t.state).map(|at| at.max(t.not_before)))
+            .min()
     }
 
     fn ask(&mut self, board: usize, s: Service) -> Option<Request> {
         self.waiting = Waiting::Answer(board);
-        Some(Request::to(self.boards[board].0, Message::Service(s)))
+        Some(Request::to(
+            self.targets[board].address,
+            Message::Service(s),
+        ))
     }
 
     fn pace(&mut self, now: Instant) {
@@ -198,113 +327,124 @@ impl Update {
             Waiting::Until(t) if now < t => return None,
             _ => self.waiting = Waiting::Nothing,
         }
+        let campaign = self.header.campaign;
         loop {
             match self.phase {
                 Phase::Announce => {
-                    if let Some(b) = self.first(|s| *s == BoardState::Announcing) {
+                    if let Some((b, ())) =
+                        self.first(now, |s| (*s == BoardState::Announcing).then_some(()))
+                    {
                         return self.ask(b, Service::RfuHeader(self.header));
                     }
                     self.phase = Phase::Broadcast(0);
                 }
                 Phase::Broadcast(n) => {
                     let receiving = self
-                        .first(|s| matches!(s, BoardState::Receiving { .. }))
-                        .is_some();
+                        .targets
+                        .iter()
+                        .any(|t| matches!(t.state, BoardState::Receiving { .. }));
                     if n >= self.header.segments() || !receiving {
                         self.phase = Phase::Repair;
                         continue;
                     }
                     self.phase = Phase::Broadcast(n + 1);
                     self.pace(now);
-                    return Some(Request::all(Message::Service(self.segment(n))));
+                    let s = self.segment(n);
+                    return Some(Request::all(Message::Service(s)));
                 }
                 Phase::Repair => {
+                    // A board announced again gets its header first.
+                    if let Some((b, ())) =
+                        self.first(now, |s| (*s == BoardState::Announcing).then_some(()))
+                    {
+                        return self.ask(b, Service::RfuHeader(self.header));
+                    }
                     // A board with segments to send again gets them, one by one.
-                    let next = self
-                        .boards
-                        .iter_mut()
-                        .enumerate()
-                        .find_map(|(i, (_, s))| match s {
-                            BoardState::Receiving { missing, .. } if !missing.is_empty() => {
-                                Some((i, missing.remove(0)))
-                            }
-                            _ => None,
-                        });
+                    let next = self.first(now, |s| match s {
+                        BoardState::Receiving { missing, .. } => missing.first().copied(),
+                        _ => None,
+                    });
                     if let Some((b, n)) = next {
-                        let to = self.boards[b].0;
+                        if let BoardState::Receiving { missing, .. } = &mut self.targets[b].state {
+                            missing.remove(0);
+                        }
+                        let to = self.targets[b].address;
                         self.pace(now);
-                        return Some(Request::to(to, Message::Service(self.segment(n))));
+                        let s = self.segment(n);
+                        return Some(Request::to(to, Message::Service(s)));
                     }
                     // Then each board still receiving is asked what it holds.
-                    let asking = self
-                        .boards
-                        .iter()
-                        .enumerate()
-                        .find_map(|(i, (_, s))| match s {
-                            BoardState::Receiving { missing, asked } if missing.is_empty() => {
-                                Some((i, *asked))
-                            }
-                            _ => None,
-                        });
+                    let asking = self.first(now, |s| match s {
+                        BoardState::Receiving { missing, asked } if missing.is_empty() => {
+                            Some(*asked)
+                        }
+                        _ => None,
+                    });
                     if let Some((b, asked)) = asking {
                         if asked > self.config.repair_rounds {
-                            self.boards[b].1 = BoardState::Failed(format!(
+                            self.targets[b].state = BoardState::Failed(format!(
                                 "segments still missing after {} repair rounds: the line to this board loses too much",
                                 self.config.repair_rounds
                             ));
                             continue;
                         }
-                        self.boards[b].1 = BoardState::Receiving {
+                        self.targets[b].state = BoardState::Receiving {
                             missing: Vec::new(),
                             asked: asked + 1,
                         };
-                        let campaign = self.header.campaign;
                         return self.ask(b, Service::RfuStatusGet { campaign });
+                    }
+                    // Boards backing off are waited for.
+                    if let Some(t) = self.next_ready(|s| s.receiving().then_some(0)) {
+                        self.waiting = Waiting::Until(t);
+                        return None;
                     }
                     self.phase = Phase::Swap;
                 }
                 Phase::Swap => {
-                    if let Some(b) = self.first(|s| *s == BoardState::Complete) {
-                        let campaign = self.header.campaign;
+                    if self.targets.iter().any(|t| t.state.receiving()) {
+                        self.phase = Phase::Repair;
+                        continue;
+                    }
+                    if let Some((b, ())) =
+                        self.first(now, |s| (*s == BoardState::Complete).then_some(()))
+                    {
                         let crc = self.header.crc;
                         return self.ask(b, Service::RfuSwap { campaign, crc });
                     }
-                    let restarting =
-                        self.boards
-                            .iter()
-                            .enumerate()
-                            .find_map(|(i, (_, s))| match s {
-                                BoardState::Restarting(at) => Some((i, *at)),
-                                _ => None,
-                            });
-                    match restarting {
-                        Some((b, at)) if now >= at + self.config.restart => {
-                            return self.ask(b, Service::FwRelGet);
-                        }
-                        Some((_, at)) => {
-                            self.waiting = Waiting::Until(at + self.config.restart);
+                    let restart = self.config.restart;
+                    let back = self.first(now, |s| match s {
+                        BoardState::Restarting(at) if now >= at + restart => Some(()),
+                        _ => None,
+                    });
+                    if let Some((b, ())) = back {
+                        return self.ask(b, Service::FwRelGet);
+                    }
+                    match self.next_ready(|s| match s {
+                        BoardState::Complete => Some(0),
+                        BoardState::Restarting(at) => Some(at + restart),
+                        _ => None,
+                    }) {
+                        Some(t) => {
+                            self.waiting = Waiting::Until(t.max(now + 1));
                             return None;
                         }
                         None => self.phase = Phase::Over,
                     }
                 }
                 Phase::Abort => {
-                    let pending = self.first(|s| {
-                        matches!(
-                            s,
-                            BoardState::Announcing
-                                | BoardState::Receiving { .. }
-                                | BoardState::Complete
-                        )
-                    });
+                    let pending = self
+                        .targets
+                        .iter()
+                        .position(|t| t.state.receiving() || t.state == BoardState::Complete);
                     if let Some(b) = pending {
-                        let campaign = self.header.campaign;
                         return self.ask(b, Service::RfuAbort { campaign });
                     }
                     // Boards swapped already finish as they would.
                     self.phase = if self
-                        .first(|s| matches!(s, BoardState::Restarting(_)))
-                        .is_some()
+                        .targets
+                        .iter()
+                        .any(|t| matches!(t.state, BoardState::Restarting(_)))
                     {
                         Phase::Swap
                     } else {
@@ -323,6 +463,9 @@ impl Update {
     pub fn abort(&mut self) {
         if self.phase != Phase::Over {
             self.phase = Phase::Abort;
+            if matches!(self.waiting, Waiting::Until(_)) {
+                self.waiting = Waiting::Nothing;
+            }
         }
     }
 
@@ -333,11 +476,11 @@ impl Update {
             return;
         };
         self.waiting = Waiting::Nothing;
-        let state = core::mem::replace(&mut self.boards[b].1, BoardState::Announcing);
+        let state = core::mem::replace(&mut self.targets[b].state, BoardState::Announcing);
         if self.phase == Phase::Abort
             && !matches!(state, BoardState::Restarting(_) | BoardState::Done)
         {
-            self.boards[b].1 = match answer {
+            self.targets[b].state = match answer {
                 Ok(Message::Ack { .. }) => BoardState::Aborted,
                 // Not told: it forgets the campaign at its next restart,
                 // and never swaps without being asked.
@@ -348,22 +491,26 @@ impl Update {
             };
             return;
         }
-        self.boards[b].1 = match (state, answer) {
-            (_, Err(why)) => BoardState::Failed(format!("did not answer: {why}")),
+        self.targets[b].state = match (state, answer) {
+            (state, Err(why)) => self.silent(b, now, state, format!("did not answer: {why}")),
             (BoardState::Announcing, Ok(Message::Ack { .. })) => BoardState::Receiving {
                 missing: Vec::new(),
                 asked: 0,
             },
-            (BoardState::Announcing, Ok(Message::Error(_))) => {
-                BoardState::Failed("refused the image (ask its RFU status for the reason)".into())
-            }
+            (BoardState::Announcing, Ok(Message::Error(_))) => self.silent(
+                b,
+                now,
+                BoardState::Announcing,
+                "refused the image (ask its RFU status for the reason)".into(),
+            ),
             (BoardState::Receiving { asked, .. }, Ok(Message::Service(Service::RfuStatus(s)))) => {
-                self.after_status(&s, asked)
+                self.after_status(b, &s, asked)
             }
             (BoardState::Complete, Ok(Message::Ack { .. })) => BoardState::Restarting(now),
-            (BoardState::Complete, Ok(Message::Error(_))) => {
-                BoardState::Failed("refused the swap: the image it holds does not check".into())
-            }
+            (BoardState::Complete, Ok(Message::Error(_))) => self.again(
+                b,
+                "refused the swap: the image it holds does not check".into(),
+            ),
             (BoardState::Restarting(_), Ok(Message::Service(Service::FwRel { firmware, .. }))) => {
                 if firmware == self.header.version {
                     BoardState::Done
@@ -386,16 +533,43 @@ impl Update {
         };
     }
 
-    fn after_status(&self, s: &Status, asked: u8) -> BoardState {
+    /// Board `b` did not answer, or refused a header: tried again after
+    /// the back-off, in the state it was in, or given up with `why`.
+    fn silent(&mut self, b: usize, now: Instant, state: BoardState, why: String) -> BoardState {
+        let t = &mut self.targets[b];
+        if t.silences >= self.config.silences {
+            return BoardState::Failed(why);
+        }
+        t.not_before = now + (self.config.backoff << t.silences);
+        t.silences += 1;
+        state
+    }
+
+    /// Board `b` lost the campaign or refused its swap: announced again
+    /// (a board keeps the segments of a header it already holds), or
+    /// given up with `why`.
+    fn again(&mut self, b: usize, why: String) -> BoardState {
+        let t = &mut self.targets[b];
+        if t.restarts >= self.config.restarts {
+            return BoardState::Failed(why);
+        }
+        t.restarts += 1;
+        BoardState::Announcing
+    }
+
+    fn after_status(&mut self, b: usize, s: &Status, asked: u8) -> BoardState {
         let count = self.header.segments();
         if s.campaign != self.header.campaign
             || !matches!(s.state(), Some(RfuState::Receiving | RfuState::Complete))
         {
-            return BoardState::Failed(format!(
-                "lost the campaign (it restarted?): status {} for campaign {}",
-                s.state().map_or("unknown", |st| st.name()),
-                s.campaign
-            ));
+            return self.again(
+                b,
+                format!(
+                    "lost the campaign (it restarted?): status {} for campaign {}",
+                    s.state().map_or("unknown", |st| st.name()),
+                    s.campaign
+                ),
+            );
         }
         let missing: Vec<usize> = s.missing(count).collect();
         if missing.is_empty() {
@@ -407,16 +581,16 @@ impl Update {
 
     /// Every board's result in words.
     pub fn report(&self) -> Vec<(Address, String)> {
-        self.boards
+        self.targets
             .iter()
-            .map(|(a, s)| {
-                let words = match s {
+            .map(|t| {
+                let words = match &t.state {
                     BoardState::Done => format!("updated to {}", self.header.version),
                     BoardState::Aborted => "not updated: the update was aborted".into(),
                     BoardState::Failed(why) => format!("not updated: {why}"),
                     other => format!("in progress ({other:?})"),
                 };
-                (*a, words)
+                (t.address, words)
             })
             .collect()
     }
@@ -564,7 +738,7 @@ mod tests {
         }
         assert_eq!(u.poll(1_000_000), None);
         assert!(u.is_done());
-        assert!(u.boards().iter().all(|(_, s)| *s == BoardState::Aborted));
+        assert!(u.boards().all(|(_, s)| *s == BoardState::Aborted));
         assert_eq!(u.report()[1].1, "not updated: the update was aborted");
     }
 
@@ -578,9 +752,20 @@ mod tests {
             UpdateConfig::default(),
         )
         .unwrap();
-        u.poll(0).unwrap();
-        u.on_answer(0, Err("did not answer 3 times".into()));
-        assert_eq!(u.poll(0), None);
+        let c = UpdateConfig::default();
+        let mut t = 0;
+        for n in 0..=c.silences {
+            let r = u.poll(t).expect("the header again");
+            assert!(matches!(r.message, Message::Service(Service::RfuHeader(_))));
+            u.on_answer(t, Err("did not answer 3 times".into()));
+            if n < c.silences {
+                assert_eq!(u.poll(t), None, "backs off");
+                let wait = c.backoff << n;
+                assert_eq!(u.poll_timeout(), Some(t + wait), "doubling");
+                t += wait;
+            }
+        }
+        assert_eq!(u.poll(t), None);
         assert!(u.is_done());
         assert!(u.report()[0].1.starts_with("not updated: did not answer"));
     }
