@@ -30,17 +30,34 @@ impl StreetDriver {
     /// board's USART, or speaking the board protocol through the bare
     /// modem from node 0's street address.
     pub fn new(sim: Sim, config: RequesterConfig) -> Self {
-        let conc = match sim.attach() {
-            Attach::Board => Concentrator::usart(config),
-            Attach::Modem => {
-                Concentrator::modem(config, sim.baud(), street_address(0), TxParams::default())
-            }
-        };
+        let conc = Self::concentrator(&sim, config);
         StreetDriver {
             sim,
             conc,
             log: Vec::new(),
         }
+    }
+
+    fn concentrator(sim: &Sim, config: RequesterConfig) -> Concentrator {
+        match sim.attach() {
+            Attach::Board => Concentrator::usart(config),
+            Attach::Modem => {
+                Concentrator::modem(config, sim.baud(), street_address(0), TxParams::default())
+            }
+        }
+    }
+
+    /// The host's cable pulled for `gone` µs, then plugged in again: every
+    /// request under way is lost, the world goes on without a host (what
+    /// it sends the host is lost), and a new concentrator starts.
+    pub fn pull_cable(&mut self, gone: Duration) {
+        let config = self.conc.requester().config();
+        self.conc.abort_all("the cable was pulled");
+        while self.conc.poll_happening().is_some() {}
+        self.sim.set_treq(false);
+        self.sim.advance_to(self.sim.now() + gone);
+        self.sim.host_read();
+        self.conc = Self::concentrator(&self.sim, config);
     }
 
     /// Virtual time now.
