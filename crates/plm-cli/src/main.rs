@@ -2,7 +2,7 @@
 //! simulated modem as a serial port over RFC 2217.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use plm_cli::sim_server;
+use plm_cli::{board, sim_server};
 use plm_core::decode::Decoder;
 use plm_core::link::{Dialect, Source};
 use std::io::{self, BufWriter, Read, Write};
@@ -29,6 +29,10 @@ enum Command {
     /// Serve a simulated modem as an RFC 2217 (Telnet COM-PORT-OPTION)
     /// serial port: RTS drives T_REQ, SET-BAUDRATE the BR pins.
     Sim(SimArgs),
+    /// Talk to street-light controller boards through a concentrator
+    /// board or a bare ST7580 on a serial device or an rfc2217:// port:
+    /// discover, status, dimming, firmware update.
+    Board(board::BoardArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -146,6 +150,7 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+        Command::Board(args) => ExitCode::from(board::run(args)),
     }
 }
 

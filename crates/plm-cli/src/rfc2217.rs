@@ -14,6 +14,11 @@
 //! The connection is treated as binary both ways whatever the client agreed
 //! to: the bytes of the modem's host interface are not text, and neither
 //! pyserial nor telnet(1) in binary mode applies NVT CR rules.
+//!
+//! [`client`] is the other side: what `plm board` and the tests connect
+//! with.
+
+pub mod client;
 
 /// Interpret As Command (RFC 854).
 pub const IAC: u8 = 255;

@@ -1,38 +1,28 @@
 //! What the `plm` tests share: the real binary run with arguments and
 //! standard input (`plm decode`), or started on a free loopback port
-//! (`plm sim`) with a minimal RFC 2217 client written here, independently
-//! of the server's codec, so that a codec bug cannot cancel itself out.
+//! (`plm sim`) and reached with `plm board`'s own RFC 2217 client
+//! ([`plm_cli::rfc2217::client`], whose parser is written apart from the
+//! server's codec, so that a codec bug cannot cancel itself out).
 //!
 //! Timeouts are generous (seconds) so that a loaded machine does not make
 //! a test flaky.
 
 // Each test file uses part of this module.
-#![allow(dead_code)]
+#![allow(dead_code, unused_imports)]
 
-use std::collections::VecDeque;
-use std::io::{BufRead, BufReader, ErrorKind, Read, Write};
-use std::net::TcpStream;
+pub use plm_cli::rfc2217::client::{com_port, Client, Telnet};
+pub use plm_cli::rfc2217::control::{RTS_OFF, RTS_ON};
+pub use plm_cli::rfc2217::escape;
+pub use plm_cli::rfc2217::{BINARY, DO, DONT, IAC, SGA, WILL, WONT};
+use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{channel, Receiver};
 use std::time::{Duration, Instant};
 
-pub const IAC: u8 = 255;
-pub const WILL: u8 = 251;
-pub const WONT: u8 = 252;
-pub const DO: u8 = 253;
-pub const DONT: u8 = 254;
-pub const SB: u8 = 250;
-pub const SE: u8 = 240;
-pub const BINARY: u8 = 0;
-pub const SGA: u8 = 3;
-pub const COM_PORT: u8 = 44;
-
+pub const COM_PORT: u8 = plm_cli::rfc2217::COM_PORT_OPTION;
 /// RFC 2217 client codes used here (the server answers with code + 100).
-pub const SET_CONTROL: u8 = 5;
-pub const NOTIFY_MODEMSTATE: u8 = 7;
-/// SET-CONTROL values: RTS on and off.
-pub const RTS_ON: u8 = 11;
-pub const RTS_OFF: u8 = 12;
+pub const SET_CONTROL: u8 = plm_cli::rfc2217::cmd::SET_CONTROL;
+pub const NOTIFY_MODEMSTATE: u8 = plm_cli::rfc2217::cmd::NOTIFY_MODEMSTATE;
 
 /// How long any one expected thing may take to come.
 pub const WAIT: Duration = Duration::from_secs(10);
@@ -120,144 +110,57 @@ impl Drop for Server {
     }
 }
 
-/// What arrived from the server, Telnet taken apart.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Telnet {
-    Negotiation(u8, u8),
-    /// A COM-PORT-OPTION subnegotiation: server code and value.
-    ComPort(u8, Vec<u8>),
-}
-
-/// Data with IAC doubled (RFC 854; RFC 2217 "Data transfer").
-pub fn escape(data: &[u8]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(data.len());
-    for &b in data {
-        out.push(b);
-        if b == IAC {
-            out.push(IAC);
-        }
-    }
-    out
-}
-
-/// A COM-PORT-OPTION command from the client (IAC doubled in the value).
-pub fn com_port(code: u8, value: &[u8]) -> Vec<u8> {
-    let mut out = vec![IAC, SB, COM_PORT, code];
-    out.extend(escape(value));
-    out.extend([IAC, SE]);
-    out
-}
-
-/// A minimal RFC 2217 client: the TCP connection with Telnet taken apart.
+/// The RFC 2217 client of `plm board` ([`plm_cli::rfc2217::client`]),
+/// whose failures here are test failures: every read also checks that
+/// the server sent nothing but negotiations, COM-PORT answers and data.
 pub struct Link {
-    stream: TcpStream,
-    /// Bytes not yet taken apart (a sequence may be split across reads).
-    raw: Vec<u8>,
-    /// Telnet items not yet looked at.
-    pub telnet: VecDeque<Telnet>,
-    /// Serial data received (IAC undone) and not yet taken.
-    data: Vec<u8>,
+    client: Client,
+}
+
+/// `link.telnet` and the other fields and methods of the client.
+impl std::ops::Deref for Link {
+    type Target = Client;
+    fn deref(&self) -> &Client {
+        &self.client
+    }
+}
+
+impl std::ops::DerefMut for Link {
+    fn deref_mut(&mut self) -> &mut Client {
+        &mut self.client
+    }
 }
 
 impl Link {
-    /// Connects to `addr`.
+    /// Connects to `addr` (nothing sent).
     pub fn connect(addr: &str) -> Link {
-        let stream = TcpStream::connect(addr).expect("connects");
-        stream.set_nodelay(true).unwrap();
         Link {
-            stream,
-            raw: Vec::new(),
-            telnet: VecDeque::new(),
-            data: Vec::new(),
+            client: Client::connect(addr).expect("connects"),
         }
     }
 
     /// Writes bytes as they are (Telnet commands, or data already escaped).
     pub fn send(&mut self, bytes: &[u8]) {
-        self.stream.write_all(bytes).unwrap();
+        self.client.send(bytes).unwrap();
     }
 
     /// Writes serial data, IAC doubled.
     pub fn send_data(&mut self, data: &[u8]) {
-        self.send(&escape(data));
+        self.client.send_data(data).unwrap();
     }
 
-    /// Whether serial data is waiting to be taken.
-    pub fn has_data(&self) -> bool {
-        !self.data.is_empty()
-    }
-
-    /// The serial data received so far and not yet taken.
-    pub fn take_data(&mut self) -> Vec<u8> {
-        std::mem::take(&mut self.data)
-    }
-
-    /// Reads what is there (waiting up to `wait`, at least 1 ms) and takes
-    /// it apart into Telnet items and serial data.
+    /// Reads what is there (waiting up to `wait`) and takes it apart.
     pub fn pump(&mut self, wait: Duration) {
-        self.stream
-            .set_read_timeout(Some(wait.max(Duration::from_millis(1))))
-            .unwrap();
-        let mut buf = [0u8; 4096];
-        match self.stream.read(&mut buf) {
-            Ok(0) => panic!("plm sim closed the connection"),
-            Ok(n) => self.raw.extend_from_slice(&buf[..n]),
-            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => return,
-            Err(e) if e.kind() == ErrorKind::Interrupted => return,
-            Err(e) => panic!("read: {e}"),
+        if let Err(e) = self.client.pump(wait) {
+            panic!("plm sim: {e}");
         }
-        let mut i = 0;
-        while i < self.raw.len() {
-            let rest = &self.raw[i..];
-            if rest[0] != IAC {
-                self.data.push(rest[0]);
-                i += 1;
-                continue;
-            }
-            let Some(&cmd) = rest.get(1) else { break };
-            match cmd {
-                IAC => {
-                    self.data.push(IAC);
-                    i += 2;
-                }
-                WILL | WONT | DO | DONT => {
-                    let Some(&option) = rest.get(2) else { break };
-                    self.telnet.push_back(Telnet::Negotiation(cmd, option));
-                    i += 3;
-                }
-                SB => {
-                    // Find IAC SE, undoing IAC IAC inside.
-                    let mut value = Vec::new();
-                    let mut j = 2;
-                    let mut end = None;
-                    while j + 1 < rest.len() {
-                        match (rest[j], rest[j + 1]) {
-                            (IAC, SE) => {
-                                end = Some(j + 2);
-                                break;
-                            }
-                            (IAC, IAC) => {
-                                value.push(IAC);
-                                j += 2;
-                            }
-                            (IAC, other) => panic!("IAC {other} inside SB"),
-                            (b, _) => {
-                                value.push(b);
-                                j += 1;
-                            }
-                        }
-                    }
-                    let Some(end) = end else { break };
-                    assert_eq!(value.first(), Some(&COM_PORT), "SB of another option");
-                    assert!(value.len() >= 2, "SB without a command");
-                    self.telnet
-                        .push_back(Telnet::ComPort(value[1], value[2..].to_vec()));
-                    i += end;
-                }
-                other => panic!("unexpected IAC {other}"),
-            }
-        }
-        self.raw.drain(..i);
+        let odd: Vec<&Telnet> = self
+            .client
+            .telnet
+            .iter()
+            .filter(|t| matches!(t, Telnet::Command(_) | Telnet::Subnegotiation(..)))
+            .collect();
+        assert!(odd.is_empty(), "unexpected Telnet from the server: {odd:?}");
     }
 
     /// Waits for the next Telnet item satisfying `want`, skipping others
@@ -265,13 +168,13 @@ impl Link {
     pub fn expect_telnet(&mut self, what: &str, want: impl Fn(&Telnet) -> bool) -> Telnet {
         let deadline = Instant::now() + WAIT;
         loop {
-            if let Some(i) = self.telnet.iter().position(&want) {
-                return self.telnet.remove(i).unwrap();
+            if let Some(i) = self.client.telnet.iter().position(&want) {
+                return self.client.telnet.remove(i).unwrap();
             }
             assert!(
                 Instant::now() < deadline,
                 "no {what}; got {:?}",
-                self.telnet
+                self.client.telnet
             );
             self.pump(Duration::from_millis(20));
         }
@@ -302,11 +205,12 @@ impl Link {
         );
         assert!(
             !self
+                .client
                 .telnet
                 .iter()
                 .any(|t| matches!(t, Telnet::Negotiation(WONT | DONT, _))),
             "refused: {:?}",
-            self.telnet
+            self.client.telnet
         );
     }
 }

@@ -1,0 +1,418 @@
+//! `plm board rfu` and `plm board image`: a remote firmware update
+//! campaign run by plm-core's engine ([`Update`]), saved after every
+//! answer so that it survives Ctrl-C, a lost port or a crash; and the
+//! simulated images to try it on `plm sim`.
+
+use super::driver::{interrupted, Driver};
+use super::{connect, exit, session, BoardArgs, Failure, ImageArgs, RfuArgs};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use plm_core::app::rfu::image;
+use plm_core::app::update::{BoardState, Update, UpdateConfig};
+use plm_core::app::{Address, AppEvent, Happening, RequestId};
+use plm_core::time::MS;
+use serde_json::json;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The state file beside `image` unless `--state` names one.
+fn state_path(args: &RfuArgs) -> PathBuf {
+    args.state.clone().unwrap_or_else(|| {
+        let mut s = args.image.as_os_str().to_owned();
+        s.push(".plm-update");
+        PathBuf::from(s)
+    })
+}
+
+/// The campaign number of an image: from its CRC-32, so that the same
+/// image gets the same number (a board holding its segments resumes).
+pub fn campaign_of(crc: u32) -> u8 {
+    (crc % 255) as u8 + 1
+}
+
+/// Writes `bytes` to `path` so that a crash leaves the old file or the
+/// new one, never half of one: a temporary file beside it, synced, then
+/// renamed over it.
+fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+    }
+    std::fs::rename(&tmp, path)
+}
+
+/// `plm board image`.
+pub fn write_image(args: &ImageArgs) -> Result<u8, Failure> {
+    let bytes = plm_sim::rfu::firmware_image(args.release, args.size as usize);
+    let info = image::check(&bytes)
+        .map_err(|why| Failure::input(format!("the image made is not good: {why} (a bug)")))?;
+    std::fs::write(&args.output, &bytes)
+        .map_err(|e| Failure::input(format!("cannot write {}: {e}", args.output.display())))?;
+    println!(
+        "{}: simulated firmware image, release {}, {} bytes, CRC-32 {:08X} (campaign {})",
+        args.output.display(),
+        info.version,
+        info.size,
+        info.crc,
+        campaign_of(info.crc)
+    );
+    Ok(exit::OK)
+}
+
+/// Where the campaign is kept between runs.
+struct State {
+    path: PathBuf,
+}
+
+impl State {
+    fn save(&self, u: &Update) -> Result<(), Failure> {
+        write_atomically(&self.path, &u.save()).map_err(|e| {
+            Failure::input(format!(
+                "cannot save the update's state to {}: {e} (choose another place with --state)",
+                self.path.display()
+            ))
+        })
+    }
+}
+
+/// `plm board rfu`.
+pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
+    let name = r.image.display().to_string();
+    let bytes = std::fs::read(&r.image)
+        .map_err(|e| Failure::input(format!("cannot read the image {name}: {e}")))?;
+    let info = image::check(&bytes).map_err(|why| {
+        Failure::input(format!(
+            "{name} is not an image the boards take: {why}. Nothing was sent."
+        ))
+    })?;
+    let state = State {
+        path: state_path(r),
+    };
+    let shown = state.path.display().to_string();
+
+    // A saved campaign is checked before the port is opened.
+    let saved = match (r.restart, std::fs::read(&state.path)) {
+        (true, _) => None,
+        (false, Ok(saved)) => Some(saved),
+        (false, Err(e)) if e.kind() == std::io::ErrorKind::NotFound => None,
+        (false, Err(e)) => {
+            return Err(Failure::input(format!(
+                "cannot read the state file {shown}: {e}"
+            )))
+        }
+    };
+    if let Some(saved) = &saved {
+        let u = Update::resume(bytes.clone(), saved, 0).map_err(|why| {
+            Failure::input(format!(
+                "the saved update in {shown} cannot go on with {name}: {why}. \
+                 Remove {shown}, or pass --restart to start a new update. Nothing was sent."
+            ))
+        })?;
+        let mut was: Vec<Address> = u.boards().map(|(a, _)| a).collect();
+        let mut now: Vec<Address> = r.nodes.clone();
+        was.sort();
+        now.sort();
+        now.dedup();
+        if !r.all && was != now {
+            let list = |v: &[Address]| {
+                v.iter()
+                    .map(|a| a.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            };
+            return Err(Failure::input(format!(
+                "the saved update in {shown} is for the boards {}, not {}: name the same boards \
+                 to resume it, or pass --restart to start a new update for these. Nothing was sent.",
+                list(&was),
+                list(&now)
+            )));
+        }
+    }
+
+    let mut d = connect(args)?;
+    let mut u = match saved {
+        Some(saved) => {
+            eprintln!("plm board: resuming the update saved in {shown}");
+            Update::resume(bytes, &saved, d.now()).map_err(Failure::input)?
+        }
+        None => {
+            let targets = if r.all {
+                find_boards(&mut d)?
+            } else {
+                let mut t: Vec<Address> = Vec::new();
+                for a in &r.nodes {
+                    if !t.contains(a) {
+                        t.push(*a);
+                    }
+                }
+                t
+            };
+            if targets.is_empty() {
+                eprintln!("plm board: no board answered the discovery: nothing to update");
+                return Ok(exit::FAILED);
+            }
+            let config = UpdateConfig {
+                gap: r.gap_ms * MS,
+                ..UpdateConfig::default()
+            };
+            Update::new(campaign_of(info.crc), info.version, bytes, &targets, config)
+                .map_err(|why| Failure::input(format!("cannot update: {why}")))?
+        }
+    };
+    let h = u.header();
+    eprintln!(
+        "plm board: campaign {}: {name}, release {}, {} bytes ({} segments), CRC-32 {:08X}, \
+         to {} board{}; progress saved in {shown}",
+        h.campaign,
+        h.version,
+        h.size,
+        h.segments(),
+        h.crc,
+        u.boards().count(),
+        if u.boards().count() == 1 { "" } else { "s" }
+    );
+    state.save(&u)?;
+
+    let mut progress = Progress::new(&u);
+    let outcome = drive(&mut d, &mut u, &state, &mut progress);
+    progress.finish();
+    match outcome {
+        Ok(()) => {}
+        Err(f) => {
+            // The state as it is now: a request under way is asked again
+            // on resume (every RFU request may be repeated).
+            let kept = state.save(&u).is_ok();
+            let how = if kept {
+                format!(
+                    "the update is saved in {shown}: run the same command again to resume it \
+                     (or pass --restart to start over)"
+                )
+            } else {
+                format!("the state could not be saved to {shown}")
+            };
+            let what = if f.code == exit::INTERRUPTED {
+                "interrupted".to_string()
+            } else {
+                f.message
+            };
+            return Err(Failure {
+                code: f.code,
+                message: format!("{what}; {how}"),
+            });
+        }
+    }
+
+    let report = u.report();
+    let updated = u
+        .boards()
+        .filter(|(_, s)| matches!(s, BoardState::Done))
+        .count();
+    for ((address, words), (_, s)) in report.iter().zip(u.boards()) {
+        if args.json {
+            println!(
+                "{}",
+                json!({
+                    "address": address.to_string(),
+                    "updated": matches!(s, BoardState::Done),
+                    "result": words,
+                })
+            );
+        } else {
+            println!("{address}  {words}");
+        }
+    }
+    if let Err(e) = std::fs::remove_file(&state.path) {
+        eprintln!(
+            "plm board: the update is over but its state file {shown} could not be removed: {e}"
+        );
+    }
+    eprintln!(
+        "plm board: {updated} of {} board{} updated to {}",
+        report.len(),
+        if report.len() == 1 { "" } else { "s" },
+        h.version
+    );
+    Ok(if updated == report.len() {
+        exit::OK
+    } else {
+        exit::FAILED
+    })
+}
+
+/// `--all`: the boards a discovery finds.
+fn find_boards(d: &mut Driver) -> Result<Vec<Address>, Failure> {
+    eprintln!("plm board: discovering the boards to update");
+    let found = d.discover(session(), 2, 40, |a, info| {
+        eprintln!("plm board: found {a} (firmware {})", info.firmware);
+    })?;
+    Ok(found.found().iter().map(|(a, _)| *a).collect())
+}
+
+/// Runs the campaign to its end: each request the engine hands out goes
+/// through the concentrator, its answer (or failure) back to the engine,
+/// and the campaign is saved after each.
+fn drive(
+    d: &mut Driver,
+    u: &mut Update,
+    state: &State,
+    progress: &mut Progress,
+) -> Result<(), Failure> {
+    let mut in_flight: Option<RequestId> = None;
+    while !(u.is_done() && in_flight.is_none()) {
+        if in_flight.is_none() {
+            if let Some(request) = u.poll(d.now()) {
+                in_flight = Some(d.submit(request)?);
+            }
+        }
+        let until = if in_flight.is_none() {
+            u.poll_timeout()
+        } else {
+            None
+        };
+        for h in d.step(until)? {
+            let Happening::App(e) = h else { continue };
+            if in_flight.is_none() || e.fate_of() != in_flight {
+                continue;
+            }
+            in_flight = None;
+            match e {
+                AppEvent::Answered { answer, .. } => u.on_answer(d.now(), Ok(answer)),
+                AppEvent::Failed { reason, .. } => u.on_answer(d.now(), Err(reason)),
+                // A segment: sent, no answer expected.
+                _ => {}
+            }
+            state.save(u)?;
+        }
+        progress.show(u);
+        if interrupted() {
+            return Err(Failure::interrupted());
+        }
+    }
+    Ok(())
+}
+
+/// Progress on stderr: one line refreshed in place on a terminal, a
+/// plain line every few seconds otherwise.
+struct Progress {
+    bar: Option<ProgressBar>,
+    started: Instant,
+    /// Bytes the engine had sent when this run started (a resumed
+    /// campaign counts its earlier runs).
+    sent_before: u64,
+    last_line: Instant,
+}
+
+/// Between two plain progress lines.
+const PLAIN_EVERY: Duration = Duration::from_secs(5);
+
+impl Progress {
+    fn new(u: &Update) -> Progress {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+            let style = ProgressStyle::with_template("[{bar:30}] {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> ");
+            bar.set_style(style);
+            bar
+        });
+        Progress {
+            bar,
+            started: Instant::now(),
+            sent_before: u.bytes_sent(),
+            last_line: Instant::now(),
+        }
+    }
+
+    fn show(&mut self, u: &Update) {
+        let (line, permille) = self.line(u);
+        match &self.bar {
+            Some(bar) => {
+                bar.set_position(permille);
+                bar.set_message(line);
+            }
+            None if self.last_line.elapsed() >= PLAIN_EVERY => {
+                self.last_line = Instant::now();
+                eprintln!("plm board: {line}");
+            }
+            None => {}
+        }
+    }
+
+    /// The words, and the average of the boards' progress in permille.
+    fn line(&self, u: &Update) -> (String, u64) {
+        let total = u.boards().count();
+        let (mut done, mut failed) = (0, 0);
+        for (_, s) in u.boards() {
+            match s {
+                BoardState::Done => done += 1,
+                BoardState::Failed(_) | BoardState::Aborted => failed += 1,
+                _ => {}
+            }
+        }
+        let permille = (0..total).map(|i| u.permille(i) as u64).sum::<u64>() / total.max(1) as u64;
+        let secs = self.started.elapsed().as_secs_f64().max(0.001);
+        let rate = (u.bytes_sent() - self.sent_before.min(u.bytes_sent())) as f64 / secs;
+        let left = u.time_left() / 1_000_000;
+        (
+            format!(
+                "{}.{} % · {done}/{total} boards updated, {failed} failed · {rate:.0} B/s · about {} left",
+                permille / 10,
+                permille % 10,
+                duration_words(left)
+            ),
+            permille,
+        )
+    }
+
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// `1 min 05 s`, `42 s`.
+fn duration_words(secs: u64) -> String {
+    match secs {
+        s if s >= 3600 => format!("{} h {:02} min", s / 3600, s / 60 % 60),
+        s if s >= 60 => format!("{} min {:02} s", s / 60, s % 60),
+        s => format!("{s} s"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn campaigns_are_1_to_255() {
+        assert_eq!(campaign_of(0), 1);
+        assert_eq!(campaign_of(254), 255);
+        assert_eq!(campaign_of(255), 1);
+        assert_eq!(campaign_of(u32::MAX), (u32::MAX % 255) as u8 + 1);
+    }
+
+    #[test]
+    fn durations_in_words() {
+        assert_eq!(duration_words(42), "42 s");
+        assert_eq!(duration_words(65), "1 min 05 s");
+        assert_eq!(duration_words(3_725), "1 h 02 min");
+    }
+
+    #[test]
+    fn a_state_file_is_replaced_whole() {
+        let dir = std::env::temp_dir().join(format!("plm-rfu-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.plm-update");
+        write_atomically(&path, b"first").unwrap();
+        write_atomically(&path, b"second").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"second");
+        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(names.len(), 1, "no temporary file left");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
