@@ -89,6 +89,11 @@ impl Server {
         }
     }
 
+    /// The lines printed so far and not yet looked at (no waiting).
+    pub fn lines_so_far(&mut self) -> Vec<String> {
+        self.lines.try_iter().collect()
+    }
+
     /// Stops it as Ctrl-C would; it must exit 0.
     pub fn interrupt(mut self) {
         let pid = self.child.id().to_string();
