@@ -104,10 +104,13 @@ pub fn run(opts: Options) -> Result<(), String> {
                 }
             },
             match attach {
-                Attach::Modem => format!("simulated ST7580 with a street of {lamps} lamps ("),
-                Attach::Board => {
-                    format!("simulated concentrator board's USART with a street of {lamps} lamps (")
+                Attach::Modem => {
+                    format!("simulated ST7580 with a street of {lamps} lamps (nodes 1-{lamps}")
                 }
+                Attach::Board => format!(
+                    "simulated concentrator board's USART with a street of {lamps} lamps \
+                     (nodes 1-{lamps}"
+                ),
             },
         ),
     };

@@ -178,8 +178,8 @@ pub enum Target {
 pub struct RfuArgs {
     /// The firmware image file (checked before anything is sent).
     pub image: PathBuf,
-    /// The boards to update (12 hex digits each).
-    #[arg(value_parser = parse_address, required_unless_present = "all")]
+    /// The boards to update (12 hex digits each), or --all.
+    #[arg(value_name = "NODE", value_parser = parse_address, required_unless_present = "all")]
     pub nodes: Vec<Address>,
     /// Discover the boards first, then update every board found.
     #[arg(long, conflicts_with = "nodes")]

@@ -399,3 +399,119 @@ impl Client {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::net::TcpListener;
+
+    /// A client and the server end of its connection.
+    fn pair() -> (Client, TcpStream) {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        let client = Client::connect(&addr).unwrap();
+        let (server, _) = listener.accept().unwrap();
+        (client, server)
+    }
+
+    /// Reads until `n` data bytes and `items` Telnet items came.
+    fn read_all(c: &mut Client, n: usize, items: usize) {
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while c.data.len() < n || c.telnet.len() < items {
+            assert!(Instant::now() < deadline, "{:?} {:?}", c.data, c.telnet);
+            c.pump(Duration::from_millis(10)).unwrap();
+        }
+    }
+
+    #[test]
+    fn every_split_of_a_stream_gives_the_same_items() {
+        let stream: Vec<u8> = [
+            &[0x02, IAC, IAC, 0x05][..],
+            &[IAC, WILL, COM_PORT_OPTION, IAC, DONT, 1],
+            // SET-BAUDRATE's answer, 57600 = 0000E100h, and a value
+            // byte FFh doubled.
+            &[IAC, SB, COM_PORT_OPTION, 101, 0, 0, 0xE1, 0, IAC, SE],
+            &[IAC, SB, COM_PORT_OPTION, 105, IAC, IAC, IAC, SE],
+            &[IAC, 241, 0x06], // NOP, then data
+        ]
+        .concat();
+        let want_items = vec![
+            Telnet::Negotiation(WILL, COM_PORT_OPTION),
+            Telnet::Negotiation(DONT, 1),
+            Telnet::ComPort(101, vec![0, 0, 0xE1, 0]),
+            Telnet::ComPort(105, vec![IAC]),
+            Telnet::Command(241),
+        ];
+        for split in 0..=stream.len() {
+            let (mut c, mut server) = pair();
+            server.write_all(&stream[..split]).unwrap();
+            server.flush().unwrap();
+            std::thread::sleep(Duration::from_millis(2));
+            c.pump(Duration::from_millis(10)).unwrap();
+            server.write_all(&stream[split..]).unwrap();
+            read_all(&mut c, 4, want_items.len());
+            assert_eq!(c.take_data(), [0x02, IAC, 0x05, 0x06], "split at {split}");
+            assert_eq!(Vec::from(c.telnet.clone()), want_items, "split at {split}");
+        }
+    }
+
+    #[test]
+    fn a_broken_subnegotiation_ends_at_the_next_command() {
+        let (mut c, mut server) = pair();
+        server
+            .write_all(&[IAC, SB, COM_PORT_OPTION, 107, 0x30, IAC, WILL, SGA, 0x41])
+            .unwrap();
+        read_all(&mut c, 1, 2);
+        assert_eq!(
+            Vec::from(c.telnet.clone()),
+            [
+                Telnet::ComPort(107, vec![0x30]),
+                Telnet::Negotiation(WILL, SGA)
+            ]
+        );
+        assert_eq!(c.take_data(), [0x41]);
+    }
+
+    /// Once negotiating, the client accepts what it supports, refuses the
+    /// rest, and never confirms its own requests (no loop can start).
+    #[test]
+    fn negotiations_are_answered_once() {
+        let (mut c, mut server) = pair();
+        c.answer = true;
+        c.us[BINARY as usize].requested = true;
+        server
+            .write_all(&[IAC, DO, BINARY, IAC, WILL, SGA, IAC, DO, 1, IAC, WILL, SGA])
+            .unwrap();
+        read_all(&mut c, 0, 4);
+        server
+            .set_read_timeout(Some(Duration::from_millis(300)))
+            .unwrap();
+        let mut got = Vec::new();
+        let mut buf = [0u8; 64];
+        while let Ok(n) = server.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            got.extend_from_slice(&buf[..n]);
+        }
+        // DO BINARY answered our WILL: nothing; WILL SGA: DO SGA once;
+        // DO ECHO: WONT ECHO.
+        assert_eq!(got, [IAC, DO, SGA, IAC, WONT, 1]);
+    }
+
+    #[test]
+    fn a_closed_connection_is_an_error() {
+        let (mut c, server) = pair();
+        drop(server);
+        let deadline = Instant::now() + Duration::from_secs(5);
+        loop {
+            match c.pump(Duration::from_millis(10)) {
+                Err(e) => {
+                    assert_eq!(e.kind(), ErrorKind::UnexpectedEof);
+                    break;
+                }
+                Ok(()) => assert!(Instant::now() < deadline),
+            }
+        }
+    }
+}
