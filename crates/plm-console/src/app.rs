@@ -10,6 +10,7 @@ use crate::views::modem::ModemView;
 use crate::views::simulator::SimulatorView;
 use crate::views::street::StreetView;
 use crate::views::traffic::TrafficView;
+use crate::views::update::UpdateView;
 use leptos::prelude::*;
 use std::time::Duration;
 
@@ -22,6 +23,8 @@ const TICK: Duration = Duration::from_millis(4);
 pub enum Tab {
     /// The street of lamps (the page opens on it).
     Street,
+    /// Remote firmware update of the street's boards.
+    Update,
     /// Traffic inspector.
     Traffic,
     /// MIB configuration.
@@ -36,8 +39,9 @@ pub enum Tab {
 
 impl Tab {
     /// Every tab.
-    pub const ALL: [Tab; 6] = [
+    pub const ALL: [Tab; 7] = [
         Tab::Street,
+        Tab::Update,
         Tab::Traffic,
         Tab::Modem,
         Tab::Data,
@@ -49,6 +53,7 @@ impl Tab {
     pub fn label(self) -> &'static str {
         match self {
             Tab::Street => "Street",
+            Tab::Update => "Firmware update",
             Tab::Traffic => "Traffic",
             Tab::Modem => "Modem",
             Tab::Data => "Data",
@@ -61,6 +66,7 @@ impl Tab {
     pub fn slug(self) -> &'static str {
         match self {
             Tab::Street => "street",
+            Tab::Update => "update",
             Tab::Traffic => "traffic",
             Tab::Modem => "modem",
             Tab::Data => "data",
@@ -104,6 +110,10 @@ pub fn App() -> impl IntoView {
     if let Some(n) = query("lamps").and_then(|n| n.parse::<usize>().ok()) {
         console.sim.lamps.set(n.clamp(1, crate::stores::MAX_LAMPS));
     }
+    // `?speed=N`: the simulated street N times as fast (demos, tests).
+    if let Some(n) = query("speed").and_then(|n| n.parse::<u32>().ok()) {
+        console.sim.speed.set(n.clamp(1, 20));
+    }
     console.connect_simulated();
     crate::bench_hook::install(console);
     if let Ok(handle) = set_interval_with_handle(move || console.tick(), TICK) {
@@ -114,6 +124,16 @@ pub fn App() -> impl IntoView {
         tab.set(Tab::from_hash(&current_hash()));
     });
     on_cleanup(move || on_hash.remove());
+    // Leaving the page mid-update asks first (the campaign is kept and
+    // can be resumed, but the boards wait meanwhile).
+    let street = console.street;
+    let on_leave = window_event_listener(leptos::ev::beforeunload, move |ev| {
+        if street.act(|s| s.campaign().is_some_and(|c| !c.update.is_done())) {
+            ev.prevent_default();
+            ev.set_return_value("a firmware update is under way");
+        }
+    });
+    on_cleanup(move || on_leave.remove());
 
     view! {
         <div class="app">
@@ -145,6 +165,9 @@ pub fn App() -> impl IntoView {
             <main>
                 <Panel tab=tab which=Tab::Street>
                     <StreetView/>
+                </Panel>
+                <Panel tab=tab which=Tab::Update>
+                    <UpdateView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Traffic>
                     <TrafficView/>

@@ -15,11 +15,13 @@ pub mod fleet;
 pub mod mibform;
 pub mod profile;
 pub mod session;
+pub mod storage;
 pub mod street;
 pub mod traffic;
 pub mod transport;
 
 pub mod app;
 pub mod bench_hook;
+pub mod campaign_store;
 pub mod stores;
 pub mod views;

@@ -46,24 +46,28 @@ pub const DUPLICATE_GRACE: Duration = 200 * MS;
 pub const ACK_SAMPLES: usize = 1_000;
 
 /// Maps the page's clock onto a transport's clock: the transport's time
-/// follows the page's, but never more than [`MAX_CATCH_UP`] at once.
+/// follows the page's (`speed` times as fast, for a simulated world; 1
+/// when 0), but never more than [`MAX_CATCH_UP`] at once.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Pacer {
     /// Page time (µs) at which the transport's clock read 0.
     origin: Option<f64>,
     /// The page's clock on the transport's clock at the last call.
     page_now: Instant,
+    /// How much faster than the page's clock (0: as fast).
+    pub speed: u32,
 }
 
 impl Pacer {
     /// Where the transport's time, now at `start`, should run to when the
     /// page's clock reads `page_us`.
     pub fn target(&mut self, page_us: f64, start: Instant) -> Instant {
-        let origin = *self.origin.get_or_insert(page_us - start as f64);
-        let target = (page_us - origin).max(0.0) as Instant;
+        let speed = self.speed.max(1) as f64;
+        let origin = *self.origin.get_or_insert(page_us - start as f64 / speed);
+        let target = ((page_us - origin) * speed).max(0.0) as Instant;
         self.page_now = target;
         if target > start + MAX_CATCH_UP {
-            self.origin = Some(page_us - (start + MAX_CATCH_UP) as f64);
+            self.origin = Some(page_us - (start + MAX_CATCH_UP) as f64 / speed);
             return start + MAX_CATCH_UP;
         }
         target

@@ -81,6 +81,9 @@ pub struct SimStore {
     pub echoed: RwSignal<u64>,
     /// Recent power line events, in words, newest last.
     pub line_events: RwSignal<VecDeque<String>>,
+    /// How much faster than the page's clock a simulated street runs
+    /// (`?speed=N`, demos and tests; 1 by default).
+    pub speed: RwSignal<u32>,
 }
 
 /// Lamps on the simulated street the page opens on.
@@ -110,6 +113,11 @@ pub struct StreetStore {
     pub sent: RwSignal<u64>,
     /// The street's clock (µs), for "last seen".
     pub now: RwSignal<Instant>,
+    /// The lamps ticked in the Street view, in the order they were
+    /// ticked (the Update view offers them as targets).
+    pub selected: RwSignal<Vec<plm_core::app::Address>>,
+    /// Bumped whenever the update campaign changed.
+    pub campaign: RwSignal<u64>,
 }
 
 impl StreetStore {
@@ -209,6 +217,7 @@ pub fn provide_console() -> Console {
             plugged: RwSignal::new(true),
             echoed: RwSignal::new(0),
             line_events: RwSignal::new(VecDeque::new()),
+            speed: RwSignal::new(1),
         },
         street: StreetStore {
             session: StoredValue::new_local(Rc::new(RefCell::new(StreetSession::idle()))),
@@ -219,6 +228,8 @@ pub fn provide_console() -> Console {
             port: RwSignal::new(String::new()),
             sent: RwSignal::new(0),
             now: RwSignal::new(0),
+            selected: RwSignal::new(Vec::new()),
+            campaign: RwSignal::new(0),
         },
         profile: RwSignal::new(Profile::default()),
     };
@@ -289,6 +300,8 @@ impl Console {
         };
         self.sim.line_events.set(VecDeque::new());
         self.connect_transport(t);
+        let speed = self.sim.speed.get_untracked();
+        self.street.act(|s| s.set_speed(speed));
     }
 
     /// Connects over `transport` (the simulated world, or a WebSerial
@@ -486,6 +499,7 @@ impl Console {
             replies,
             traffic,
             sent,
+            campaign,
         } = tick;
         let (sweep, discovering, now) = {
             let session = self.street.session();
@@ -501,6 +515,10 @@ impl Console {
         }
         if sent > 0 {
             street.sent.update(|n| *n += sent);
+        }
+        if campaign {
+            self.street.act(crate::campaign_store::save);
+            street.campaign.update(|v| *v += 1);
         }
         if !traffic.is_empty() {
             self.traffic.log.update(|log| {

@@ -6,6 +6,10 @@
 //! Like [`crate::session`], it has no browser in it: time comes in as an
 //! argument, so its tests run natively against a simulated street.
 
+mod campaign;
+
+pub use campaign::{campaign_of, Campaign};
+
 use crate::session::{Budget, Pacer};
 use crate::transport::{LinkState, Transport};
 use plm_core::app::hid::{self, Hid, LampState};
@@ -107,6 +111,8 @@ enum Purpose {
     Snr(Address),
     Dim(Address, u8),
     View(StreetReply),
+    /// A request of the update campaign (`true`: a broadcast).
+    Update(bool),
 }
 
 /// What a tick produced.
@@ -123,6 +129,8 @@ pub struct StreetTick {
     pub traffic: Vec<(Instant, Decoded)>,
     /// Frames the console sent towards the street.
     pub sent: u64,
+    /// The update campaign changed (to save it, and to show it).
+    pub campaign: bool,
 }
 
 /// The street session.
@@ -140,6 +148,7 @@ pub struct StreetSession {
     /// Names the modem's host-interface traffic (bare modem profile).
     decoder: Decoder,
     out: StreetTick,
+    campaign: Option<Campaign>,
 }
 
 impl StreetSession {
@@ -159,6 +168,7 @@ impl StreetSession {
             purposes: HashMap::new(),
             decoder: Decoder::new(Dialect::St7580, Source::Any),
             out: StreetTick::default(),
+            campaign: None,
         }
     }
 
@@ -175,6 +185,11 @@ impl StreetSession {
     /// A session through a concentrator board's USART.
     pub fn via_board(transport: Box<dyn Transport>) -> Self {
         Self::new(transport, Concentrator::usart(RequesterConfig::default()))
+    }
+
+    /// Runs a simulated street `speed` times as fast as the page's clock.
+    pub fn set_speed(&mut self, speed: u32) {
+        self.pacer.speed = speed;
     }
 
     /// The transport.
@@ -322,6 +337,7 @@ impl StreetSession {
                 self.conc.poll_timeout(),
                 self.discovery.as_ref().and_then(|d| d.poll_timeout()),
                 self.next_sweep,
+                self.update_timeout(),
             ] {
                 if let Some(d) = d.filter(|d| *d > t && *d < next) {
                     next = d;
@@ -339,6 +355,7 @@ impl StreetSession {
             self.handle_happenings();
             self.run_discovery(next);
             self.run_sweep(next);
+            self.run_update(next);
             self.flush();
             t = next;
         }
@@ -373,7 +390,9 @@ impl StreetSession {
     }
 
     fn run_sweep(&mut self, now: Instant) {
-        if !self.sweep.on || self.discovery.is_some() {
+        // A firmware update has the line to itself.
+        let updating = self.campaign.as_ref().is_some_and(|c| !c.update.is_done());
+        if !self.sweep.on || self.discovery.is_some() || updating {
             return;
         }
         if self.next_sweep.is_some_and(|t| t <= now) {
@@ -565,6 +584,7 @@ impl StreetSession {
                 self.read(a);
             }
             (Purpose::View(reply), r) => self.out.replies.push((reply, r)),
+            (Purpose::Update(broadcast), r) => self.update_answer(now, broadcast, r),
             _ => {}
         }
         self.out.changed = true;

@@ -5,11 +5,25 @@ use wasm_bindgen::{JsCast, JsValue};
 
 /// Offers `text` as a file named `name` to download.
 pub fn download(name: &str, mime: &str, text: &str) -> Result<(), String> {
+    offer(name, mime, &JsValue::from_str(text))
+}
+
+/// Offers `bytes` as a file named `name` to download.
+pub fn download_bytes(name: &str, bytes: &[u8]) -> Result<(), String> {
+    offer(
+        name,
+        "application/octet-stream",
+        &js_sys::Uint8Array::from(bytes),
+    )
+}
+
+fn offer(name: &str, mime: &str, part: &JsValue) -> Result<(), String> {
     let err = |e: JsValue| format!("the browser refused the download: {e:?}");
-    let parts = js_sys::Array::of1(&JsValue::from_str(text));
+    let parts = js_sys::Array::of1(part);
     let opts = web_sys::BlobPropertyBag::new();
     opts.set_type(mime);
-    let blob = web_sys::Blob::new_with_str_sequence_and_options(&parts, &opts).map_err(err)?;
+    let blob =
+        web_sys::Blob::new_with_buffer_source_sequence_and_options(&parts, &opts).map_err(err)?;
     let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(err)?;
     let document = web_sys::window()
         .and_then(|w| w.document())
@@ -42,4 +56,12 @@ pub async fn read_text(file: &web_sys::File) -> Result<String, String> {
         .map_err(|e| format!("the file could not be read: {e:?}"))?;
     text.as_string()
         .ok_or_else(|| "the file is not text".to_string())
+}
+
+/// The bytes of a file.
+pub async fn read_bytes(file: &web_sys::File) -> Result<Vec<u8>, String> {
+    let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
+        .await
+        .map_err(|e| format!("the file could not be read: {e:?}"))?;
+    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
 }

@@ -13,6 +13,7 @@ pub mod simulator;
 pub mod snr_plot;
 pub mod street;
 pub mod traffic;
+pub mod update;
 pub mod widgets;
 
 use plm_core::time::Instant;

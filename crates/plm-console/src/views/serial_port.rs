@@ -47,18 +47,10 @@ mod wasm {
     const KEY_POLARITY: &str = "plm-console.serial.polarity";
     const KEY_PORT: &str = "plm-console.serial.port";
 
-    fn storage() -> Option<web_sys::Storage> {
-        web_sys::window()?.local_storage().ok()?
-    }
-
-    fn load(key: &str) -> Option<String> {
-        storage()?.get_item(key).ok()?
-    }
+    use crate::storage::load;
 
     fn save(key: &str, value: &str) {
-        if let Some(s) = storage() {
-            let _ = s.set_item(key, value);
-        }
+        crate::storage::store(key, Some(value));
     }
 
     /// The panel's state; `Copy`, shared by the handlers.

@@ -17,8 +17,7 @@ pub fn StreetView() -> impl IntoView {
     let street = use_console().street;
     let filter = RwSignal::new(String::new());
     let sort = RwSignal::new(("address", true));
-    // The lamps ticked, in the order they were ticked.
-    let selected = RwSignal::new(Vec::<Address>::new());
+    let selected = street.selected;
     let focus = RwSignal::new(None::<Address>);
     let message = RwSignal::new(None::<String>);
     // The rows shown, sorted and filtered; the table keys its lines by

@@ -96,6 +96,19 @@ pub enum BoardState {
 }
 
 impl BoardState {
+    /// Where it is, in a few words.
+    pub fn words(&self) -> &'static str {
+        match self {
+            BoardState::Announcing => "announcing",
+            BoardState::Receiving { .. } => "receiving",
+            BoardState::Complete => "verified, waiting for its swap",
+            BoardState::Restarting(_) => "swapped, restarting",
+            BoardState::Done => "updated",
+            BoardState::Aborted => "not updated: cancelled",
+            BoardState::Failed(_) => "failed",
+        }
+    }
+
     /// Still to get segments (or its header).
     fn receiving(&self) -> bool {
         matches!(self, BoardState::Announcing | BoardState::Receiving { .. })
@@ -113,6 +126,8 @@ struct Target {
     restarts: u8,
     /// Not to be asked before this time (back-off).
     not_before: Instant,
+    /// Done before a resume: its release is being read back.
+    rechecked: bool,
 }
 
 /// Where the campaign is.
@@ -184,6 +199,7 @@ impl Update {
                     silences: 0,
                     restarts: 0,
                     not_before: 0,
+                    rechecked: false,
                 })
                 .collect(),
             phase: Phase::Announce,
@@ -394,15 +410,11 @@ impl Update {
                         };
                         return self.ask(b, Service::RfuStatusGet { campaign });
                     }
-                    // Boards backing off are waited for.
-                    if let Some(t) = self.next_ready(|s| s.receiving().then_some(0)) {
-                        self.waiting = Waiting::Until(t);
-                        return None;
-                    }
+                    // The boards backing off wait; the others go on.
                     self.phase = Phase::Swap;
                 }
                 Phase::Swap => {
-                    if self.targets.iter().any(|t| t.state.receiving()) {
+                    if self.first(now, |s| s.receiving().then_some(())).is_some() {
                         self.phase = Phase::Repair;
                         continue;
                     }
@@ -421,7 +433,9 @@ impl Update {
                         return self.ask(b, Service::FwRelGet);
                     }
                     match self.next_ready(|s| match s {
-                        BoardState::Complete => Some(0),
+                        BoardState::Announcing
+                        | BoardState::Receiving { .. }
+                        | BoardState::Complete => Some(0),
                         BoardState::Restarting(at) => Some(at + restart),
                         _ => None,
                     }) {
@@ -514,22 +528,19 @@ impl Update {
             (BoardState::Restarting(_), Ok(Message::Service(Service::FwRel { firmware, .. }))) => {
                 if firmware == self.header.version {
                     BoardState::Done
+                } else if self.targets[b].rechecked {
+                    // Done before a resume, not any more: announced again.
+                    self.targets[b].rechecked = false;
+                    self.again(b, format!("runs release {firmware} again"))
                 } else {
                     BoardState::Failed(format!(
                         "came back on release {firmware}: the new image did not start and the board went back to the old one"
                     ))
                 }
             }
-            (state, Ok(other)) => BoardState::Failed(format!(
-                "answered {other:?} while {}",
-                match state {
-                    BoardState::Announcing => "announcing",
-                    BoardState::Receiving { .. } => "receiving",
-                    BoardState::Complete => "swapping",
-                    BoardState::Restarting(_) => "restarting",
-                    _ => "over",
-                }
-            )),
+            (state, Ok(other)) => {
+                BoardState::Failed(format!("answered {} while {}", other.name(), state.words()))
+            }
         };
     }
 
@@ -588,7 +599,7 @@ impl Update {
                     BoardState::Done => format!("updated to {}", self.header.version),
                     BoardState::Aborted => "not updated: the update was aborted".into(),
                     BoardState::Failed(why) => format!("not updated: {why}"),
-                    other => format!("in progress ({other:?})"),
+                    other => format!("in progress: {}", other.words()),
                 };
                 (t.address, words)
             })

@@ -15,7 +15,9 @@
 //! On resume, a request whose answer never came is asked again (every RFU
 //! request may be repeated: a header of the campaign a board holds
 //! resumes it, a swap already made is acknowledged again), a board
-//! restarting gets the restart time again, and back-offs start afresh.
+//! restarting gets the restart time again, a board done has its release
+//! read back again (it may have been replaced, or gone back to its old
+//! image, while nobody watched), and back-offs start afresh.
 
 use super::{BoardState, Phase, Target, Update, UpdateConfig, Waiting};
 use crate::app::frame::Address;
@@ -140,7 +142,9 @@ impl Update {
                 }
                 2 => BoardState::Complete,
                 3 => BoardState::Restarting(now),
-                4 => BoardState::Done,
+                // Read back again: the board may have been replaced, or
+                // its trial cut short, while nobody watched.
+                4 => BoardState::Restarting(now.saturating_sub(config.restart)),
                 5 => BoardState::Aborted,
                 6 => {
                     let n = r.u16()? as usize;
@@ -152,6 +156,7 @@ impl Update {
             };
             targets.push(Target {
                 address,
+                rechecked: tag == 4,
                 state,
                 silences,
                 restarts,

@@ -1,0 +1,273 @@
+//! A firmware update campaign driven by the street session: plm-core's
+//! [`Update`] engine fed through the session's concentrator, one request
+//! at a time, with pause, cancel, and resume from what was saved.
+
+use super::{Purpose, StreetSession};
+use crate::transport::LinkState;
+use plm_core::app::rfu::image;
+use plm_core::app::update::{Update, UpdateConfig};
+use plm_core::app::{Address, Message};
+use plm_core::time::Instant;
+
+/// A campaign under way (or over, its results kept until dismissed).
+pub struct Campaign {
+    /// The engine.
+    pub update: Update,
+    /// Paused by the user: nothing more is sent until resumed.
+    pub paused: bool,
+    /// When it started or resumed, on the session's clock.
+    pub since: Instant,
+    /// A request of the engine is under way.
+    in_flight: bool,
+    /// The sweep ran before: it runs again when the update is over.
+    sweep_was_on: bool,
+}
+
+/// The campaign number of an image: from its CRC-32, so that the same
+/// image sent again resumes on boards that still hold its segments.
+pub fn campaign_of(crc: u32) -> u8 {
+    (crc % 255) as u8 + 1
+}
+
+impl StreetSession {
+    /// The campaign, if one was started.
+    pub fn campaign(&self) -> Option<&Campaign> {
+        self.campaign.as_ref()
+    }
+
+    /// Starts updating `targets` with `image`, refused in words (before
+    /// anything is sent) when the image cannot be a whole firmware image.
+    pub fn start_update(&mut self, image: Vec<u8>, targets: &[Address]) -> Result<(), String> {
+        let info = image::check(&image)?;
+        let u = Update::new(
+            campaign_of(info.crc),
+            info.version,
+            image,
+            targets,
+            UpdateConfig::default(),
+        )?;
+        self.begin(u);
+        Ok(())
+    }
+
+    /// Goes on with a campaign saved by [`Update::save`].
+    pub fn resume_update(&mut self, image: Vec<u8>, saved: &[u8]) -> Result<(), String> {
+        let u = Update::resume(image, saved, self.now())?;
+        self.begin(u);
+        Ok(())
+    }
+
+    fn begin(&mut self, update: Update) {
+        let sweep_was_on = self.sweep.on;
+        self.set_sweep(false);
+        self.campaign = Some(Campaign {
+            update,
+            paused: false,
+            since: self.now(),
+            in_flight: false,
+            sweep_was_on,
+        });
+        self.out.campaign = true;
+    }
+
+    /// Pauses or resumes sending.
+    pub fn pause_update(&mut self, paused: bool) {
+        if let Some(c) = self.campaign.as_mut() {
+            c.paused = paused;
+            self.out.campaign = true;
+        }
+    }
+
+    /// Cancels: boards not swapped yet forget the campaign and keep their
+    /// release; boards swapped already finish.
+    pub fn cancel_update(&mut self) {
+        if let Some(c) = self.campaign.as_mut() {
+            c.update.abort();
+            c.paused = false;
+            self.out.campaign = true;
+        }
+    }
+
+    /// Forgets a campaign that is over (its results were seen).
+    pub fn dismiss_update(&mut self) {
+        if self.campaign.as_ref().is_some_and(|c| c.update.is_done()) {
+            self.campaign = None;
+            self.out.campaign = true;
+        }
+    }
+
+    /// When the engine has something to send again, if it waits for time.
+    pub(super) fn update_timeout(&self) -> Option<Instant> {
+        self.campaign.as_ref().and_then(|c| c.update.poll_timeout())
+    }
+
+    /// Hands the engine's next request to the concentrator.
+    pub(super) fn run_update(&mut self, now: Instant) {
+        let Some(c) = self.campaign.as_mut() else {
+            return;
+        };
+        if c.in_flight || (c.paused && !c.update.is_aborting()) || c.update.is_done() {
+            return;
+        }
+        // With the cable out the campaign waits (its state is saved); it
+        // goes on once connected again.
+        if matches!(self.state(), LinkState::Disconnected(_)) {
+            return;
+        }
+        let Some(c) = self.campaign.as_mut() else {
+            return;
+        };
+        if let Some(r) = c.update.poll(now) {
+            c.in_flight = true;
+            self.out.campaign = true;
+            let broadcast = r.broadcast;
+            self.submit(r, Purpose::Update(broadcast));
+        }
+        if self.campaign.as_ref().is_some_and(|c| c.update.is_done()) {
+            self.update_over();
+        }
+    }
+
+    /// The fate of the engine's request.
+    pub(super) fn update_answer(
+        &mut self,
+        now: Instant,
+        broadcast: bool,
+        r: Result<Message, String>,
+    ) {
+        let Some(c) = self.campaign.as_mut() else {
+            return;
+        };
+        c.in_flight = false;
+        if !broadcast {
+            c.update.on_answer(now, r);
+            self.out.campaign = true;
+        }
+        if c.update.is_done() {
+            self.update_over();
+        }
+    }
+
+    fn update_over(&mut self) {
+        let Some(c) = self.campaign.as_ref() else {
+            return;
+        };
+        let version = c.update.header().version;
+        let done: Vec<Address> = c
+            .update
+            .boards()
+            .filter(|(_, s)| **s == plm_core::app::update::BoardState::Done)
+            .map(|(a, _)| a)
+            .collect();
+        let sweep = c.sweep_was_on;
+        for a in done {
+            if let Some(d) = self.lamp(a).discovered.as_mut() {
+                d.firmware = version;
+            }
+        }
+        self.out.campaign = true;
+        self.out.changed = true;
+        if sweep {
+            self.set_sweep(true);
+        }
+        if let Some(c) = self.campaign.as_mut() {
+            c.sweep_was_on = false;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transport::sim::SimTransport;
+    use plm_core::app::update::BoardState;
+    use plm_core::app::{Concentrator, Release, RequesterConfig};
+    use plm_core::time::{Duration, MS};
+    use plm_sim::board::street_address;
+    use plm_sim::rfu::firmware_image;
+    use plm_sim::Attach;
+
+    const S: Duration = 1_000 * MS;
+    const NEW: Release = Release { major: 1, minor: 9 };
+
+    fn street(lamps: usize) -> StreetSession {
+        let t = Box::new(SimTransport::street(lamps, Attach::Board, 57_600, 5));
+        StreetSession::new(t, Concentrator::usart(RequesterConfig::default()))
+    }
+
+    fn run(s: &mut StreetSession, d: Duration) {
+        let start = s.now();
+        s.run_until(start, start + d);
+        s.take();
+    }
+
+    fn release_of(s: &StreetSession, node: usize) -> Release {
+        s.fleet()[&street_address(node)]
+            .discovered
+            .unwrap()
+            .firmware
+    }
+
+    /// Two lamps of three updated through the session: the sweep stops
+    /// for the update and comes back, the fleet shows the new release;
+    /// a bad image is refused before anything is sent.
+    #[test]
+    fn lamps_are_updated_through_the_session() {
+        let mut s = street(3);
+        s.discover();
+        run(&mut s, 40 * S);
+        assert_eq!(s.fleet().len(), 3);
+        let old = release_of(&s, 3);
+        let mut truncated = firmware_image(NEW, 3_000);
+        truncated.truncate(2_000);
+        assert!(s
+            .start_update(truncated, &[street_address(1)])
+            .unwrap_err()
+            .starts_with("truncated"));
+        assert!(s.campaign().is_none(), "nothing started");
+
+        let targets = [street_address(1), street_address(2)];
+        s.start_update(firmware_image(NEW, 3_000), &targets)
+            .unwrap();
+        assert!(!s.sweep().on, "the sweep leaves the line to the update");
+        run(&mut s, 120 * S);
+        let c = s.campaign().unwrap();
+        assert!(c.update.is_done(), "{:?}", c.update.report());
+        assert!(c.update.boards().all(|(_, st)| *st == BoardState::Done));
+        assert_eq!(release_of(&s, 1), NEW);
+        assert_eq!(release_of(&s, 2), NEW);
+        assert_eq!(release_of(&s, 3), old);
+        assert!(s.sweep().on, "the sweep is back");
+        s.dismiss_update();
+        assert!(s.campaign().is_none());
+    }
+
+    /// A campaign saved mid-way goes on in a new session (a reload with
+    /// the same street behind the cable) and finishes.
+    #[test]
+    fn a_saved_campaign_resumes_in_a_new_session() {
+        let mut s = street(2);
+        s.discover();
+        run(&mut s, 30 * S);
+        let image = firmware_image(NEW, 4_000);
+        s.start_update(image.clone(), &[street_address(1), street_address(2)])
+            .unwrap();
+        run(&mut s, 6 * S);
+        let saved = s.campaign().unwrap().update.save();
+        // The page goes; the street (behind the cable) stays.
+        let transport = s.transport.take().unwrap();
+        let mut s = StreetSession::new(transport, Concentrator::usart(RequesterConfig::default()));
+        assert!(
+            s.resume_update(vec![0; 10], &saved).is_err(),
+            "another image"
+        );
+        s.resume_update(image, &saved).unwrap();
+        run(&mut s, 120 * S);
+        let c = s.campaign().unwrap();
+        assert!(
+            c.update.boards().all(|(_, st)| *st == BoardState::Done),
+            "{:?}",
+            c.update.report()
+        );
+    }
+}

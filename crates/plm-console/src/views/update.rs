@@ -1,0 +1,359 @@
+//! The Update view: remote firmware update of the street's boards
+//! (plm-core's update engine, driven by the street session). An image
+//! file is checked before anything is sent; the lamps to update are one,
+//! the Street view's selection, every lamp of a release, or all; progress
+//! per board and overall with rate and time left; pause, cancel; a
+//! campaign cut short (reload, closed tab, pulled cable) is offered again
+//! from what the browser kept; the results export as CSV.
+
+use super::files::{chosen_file, download, download_bytes, read_bytes};
+use super::widgets::{button, note};
+use crate::campaign_store;
+use crate::stores::{use_console, StreetStore};
+use leptos::prelude::*;
+use plm_core::app::rfu::image::{self, Image};
+use plm_core::app::{Address, Release};
+
+/// The image chosen, and what its check said.
+#[derive(Clone)]
+struct Chosen {
+    name: String,
+    bytes: Vec<u8>,
+    check: Result<Image, String>,
+}
+
+impl Chosen {
+    fn of(name: String, bytes: Vec<u8>) -> Chosen {
+        let check = image::check(&bytes);
+        Chosen { name, bytes, check }
+    }
+
+    fn words(&self) -> String {
+        match &self.check {
+            Ok(i) => format!(
+                "{}: {} bytes, release {}, CRC-32 {:08X}",
+                self.name, i.size, i.version, i.crc
+            ),
+            Err(why) => format!("{} refused: {why}", self.name),
+        }
+    }
+}
+
+/// `x.y` as a release.
+fn release(text: &str) -> Option<Release> {
+    let (x, y) = text.trim().split_once('.')?;
+    Some(Release {
+        major: x.parse().ok()?,
+        minor: y.parse().ok()?,
+    })
+}
+
+/// The lamps a choice of the target list names.
+fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
+    let with_release = |r: Option<Release>| {
+        street.with_fleet(|f| {
+            f.values()
+                .filter(|l| r.is_none() || l.discovered.map(|d| d.firmware) == r)
+                .map(|l| l.address)
+                .collect()
+        })
+    };
+    match choice.split_once(':') {
+        Some(("release", r)) => with_release(release(r)),
+        Some(("lamp", a)) => Address::parse(a).into_iter().collect(),
+        _ if choice == "selected" => street.selected.get_untracked(),
+        _ => with_release(None),
+    }
+}
+
+/// The view.
+#[component]
+pub fn UpdateView() -> impl IntoView {
+    let street = use_console().street;
+    let chosen = RwSignal::new(None::<Chosen>);
+    let choice = RwSignal::new(String::from("all"));
+    let message = RwSignal::new(None::<String>);
+    let make_release = RwSignal::new(String::from("1.5"));
+    let make_size = RwSignal::new(String::from("24576"));
+    let running = move || {
+        street.campaign.track();
+        street.act(|s| s.campaign().map(|c| !c.update.is_done()))
+    };
+
+    let on_file = move |ev: leptos::ev::Event| {
+        let Some(file) = chosen_file(&ev) else {
+            return;
+        };
+        leptos::task::spawn_local(async move {
+            match read_bytes(&file).await {
+                Ok(bytes) => chosen.set(Some(Chosen::of(file.name(), bytes))),
+                Err(e) => message.set(Some(e)),
+            }
+        });
+    };
+    let make = move || {
+        let Some(v) = release(&make_release.get_untracked()) else {
+            return message.set(Some("the release is x.y, two numbers 0-255".into()));
+        };
+        let size = make_size
+            .get_untracked()
+            .trim()
+            .parse::<usize>()
+            .unwrap_or(0);
+        if !(image::IMAGE_MIN..=plm_core::app::rfu::IMAGE_MAX).contains(&size) {
+            return message.set(Some(format!(
+                "the size is {} to {} bytes",
+                image::IMAGE_MIN,
+                plm_core::app::rfu::IMAGE_MAX
+            )));
+        }
+        let bytes = plm_sim::rfu::firmware_image(v, size);
+        chosen.set(Some(Chosen::of(format!("simulated-{v}.bin"), bytes)));
+        message.set(None);
+    };
+    let start = move || {
+        let Some(c) = chosen.get_untracked() else {
+            return message.set(Some("choose an image file first".into()));
+        };
+        let list = targets(street, &choice.get_untracked());
+        let r = street.act(|s| s.start_update(c.bytes, &list));
+        message.set(Some(match r {
+            Ok(()) => format!("update started on {} lamp(s)", list.len()),
+            Err(e) => format!("nothing sent: {e}"),
+        }));
+    };
+    let saved = RwSignal::new(campaign_store::saved());
+    let resume = move || {
+        let Some((image, progress)) = saved.get_untracked() else {
+            return;
+        };
+        let r = street.act(|s| s.resume_update(image, &progress));
+        message.set(Some(match r {
+            Ok(()) => "update resumed where it was saved".into(),
+            Err(e) => format!("cannot resume: {e}"),
+        }));
+        saved.set(None);
+    };
+    let discard = move || {
+        campaign_store::discard();
+        saved.set(None);
+    };
+
+    view! {
+        <div class="update">
+            {move || (saved.with(|s| s.is_some()) && running().is_none()).then(|| view! {
+                <div class="alerts" id="update-saved" role="alert">
+                    <b>"An update was cut short (page closed or reloaded, cable pulled). "</b>
+                    "Resume it: boards that hold segments keep them; every board's state is asked again. "
+                    {button("update-resume", "Resume update", "", resume)}
+                    {button("update-discard", "Discard", "the boards keep what they run; segments they hold are dropped at the next update", discard)}
+                </div>
+            })}
+            <div class="toolbar">
+                <label>
+                    "Image file "
+                    <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_file/>
+                </label>
+                <span class="muted">"or make a simulated one: release "</span>
+                <input id="update-make-release" size="5" prop:value=move || make_release.get() on:input=move |ev| make_release.set(event_target_value(&ev))/>
+                <span class="muted">" bytes "</span>
+                <input id="update-make-size" size="6" prop:value=move || make_size.get() on:input=move |ev| make_size.set(event_target_value(&ev))/>
+                {button("update-make", "Make image", "a firmware image the simulated boards run", make)}
+                <button
+                    id="update-save-image"
+                    prop:disabled=move || chosen.with(|c| c.is_none())
+                    on:click=move |_| {
+                        if let Some(c) = chosen.get_untracked() {
+                            let _ = download_bytes(&c.name, &c.bytes);
+                        }
+                    }
+                >
+                    "Save image file"
+                </button>
+            </div>
+            <p
+                id="update-image"
+                class=move || if chosen.with(|c| matches!(c, Some(Chosen { check: Err(_), .. }))) { "message error" } else { "message" }
+            >
+                {move || chosen.with(|c| c.as_ref().map_or("no image chosen".into(), Chosen::words))}
+            </p>
+            <div class="toolbar">
+                <label>
+                    "Lamps "
+                    <select id="update-targets" on:change=move |ev| choice.set(event_target_value(&ev))>
+                        {move || target_options(street)}
+                    </select>
+                </label>
+                <button
+                    id="update-start"
+                    prop:disabled=move || running() == Some(true) || !chosen.with(|c| matches!(c, Some(Chosen { check: Ok(_), .. })))
+                    on:click=move |_| start()
+                >
+                    "Start update"
+                </button>
+            </div>
+            {note("update-message", "message", message)}
+            <Progress/>
+        </div>
+    }
+}
+
+/// The target list: all, the selection, each release, each lamp.
+fn target_options(street: StreetStore) -> impl IntoView {
+    street.version.track();
+    let selected = street.selected.with(|s| s.len());
+    let (mut releases, lamps): (Vec<Release>, Vec<(Address, String)>) = street.with_fleet(|f| {
+        (
+            f.values()
+                .filter_map(|l| l.discovered.map(|d| d.firmware))
+                .collect(),
+            f.values()
+                .map(|l| {
+                    let r = l.discovered.map_or("?".into(), |d| d.firmware.to_string());
+                    (l.address, r)
+                })
+                .collect(),
+        )
+    });
+    releases.sort();
+    let mut options = vec![("all".to_string(), format!("every lamp ({})", lamps.len()))];
+    if selected > 0 {
+        options.push((
+            "selected".into(),
+            format!("lamps selected in the Street view ({selected})"),
+        ));
+    }
+    let mut i = 0;
+    while i < releases.len() {
+        let r = releases[i];
+        let n = releases[i..].iter().take_while(|x| **x == r).count();
+        options.push((
+            format!("release:{r}"),
+            format!("lamps on release {r} ({n})"),
+        ));
+        i += n;
+    }
+    for (a, r) in lamps {
+        options.push((format!("lamp:{a}"), format!("lamp {a} (release {r})")));
+    }
+    options
+        .into_iter()
+        .map(|(value, label)| view! { <option value=value>{label}</option> })
+        .collect_view()
+}
+
+/// One board's line: address, state, its segments held, the result.
+type Line = (Address, &'static str, u16, String);
+
+/// What the progress card shows, read from the campaign at once.
+struct Snapshot {
+    lines: Vec<Line>,
+    done: usize,
+    failed: usize,
+    paused: bool,
+    over: bool,
+    summary: String,
+}
+
+fn snapshot(street: StreetStore) -> Option<Snapshot> {
+    street.campaign.track();
+    street.act(|s| {
+        let now = s.now();
+        let c = s.campaign()?;
+        let u = &c.update;
+        let report = u.report();
+        let lines: Vec<Line> = u
+            .boards()
+            .enumerate()
+            .zip(report)
+            .map(|((i, (a, st)), (_, words))| (a, st.words(), u.permille(i), words))
+            .collect();
+        let done = lines.iter().filter(|l| l.1 == "updated").count();
+        let failed = lines
+            .iter()
+            .filter(|l| l.3.starts_with("not updated"))
+            .count();
+        let elapsed = now.saturating_sub(c.since).max(1);
+        let rate = u.bytes_sent() * 1_000_000 / elapsed;
+        let left = u.time_left() / 1_000_000;
+        let summary = format!(
+            "release {}: {done} of {} updated, {failed} not · {rate} B/s · {}",
+            u.header().version,
+            lines.len(),
+            if u.is_done() {
+                "over".to_string()
+            } else if left >= 120 {
+                format!("about {} min left", left.div_ceil(60))
+            } else {
+                format!("about {left} s left")
+            }
+        );
+        Some(Snapshot {
+            lines,
+            done,
+            failed,
+            paused: c.paused,
+            over: u.is_done(),
+            summary,
+        })
+    })
+}
+
+#[component]
+fn Progress() -> impl IntoView {
+    let street = use_console().street;
+    let export = move || {
+        let Some(s) = snapshot(street) else {
+            return;
+        };
+        let mut csv = String::from("address,result\n");
+        for (a, _, _, words) in &s.lines {
+            csv.push_str(&format!("{a},\"{}\"\n", words.replace('"', "'")));
+        }
+        let _ = download("update-results.csv", "text/csv", &csv);
+    };
+    move || {
+        let s = snapshot(street)?;
+        let total = s.lines.len().max(1);
+        let overall: usize = s.lines.iter().map(|l| l.2 as usize).sum::<usize>() / total;
+        let (paused, over) = (s.paused, s.over);
+        Some(view! {
+            <div class="card" id="update-progress-card">
+                <p id="update-summary"><b>{s.summary.clone()}</b></p>
+                <progress id="update-progress" max="1000" value=overall.to_string()></progress>
+                <div class="toolbar">
+                    {(!over).then(|| button(
+                        "update-pause",
+                        if paused { "Resume sending" } else { "Pause" },
+                        "",
+                        move || street.act(|x| x.pause_update(!paused)),
+                    ))}
+                    {(!over).then(|| button(
+                        "update-cancel",
+                        "Cancel update",
+                        "boards not swapped yet keep their release and forget the segments",
+                        move || street.act(|x| x.cancel_update()),
+                    ))}
+                    {over.then(|| button("update-export", "Export results (CSV)", "", export))}
+                    {over.then(|| button("update-dismiss", "Close", "", move || street.act(|x| x.dismiss_update())))}
+                    <span class="muted">{format!("{} updated, {} not updated", s.done, s.failed)}</span>
+                </div>
+                <div class="table-wrap">
+                    <table class="log" id="update-boards">
+                        <thead><tr><th>"Lamp"</th><th>"State"</th><th>"Segments held"</th><th>"Result"</th></tr></thead>
+                        <tbody>
+                            {s.lines.iter().map(|(a, st, pm, words)| view! {
+                                <tr class=if words.starts_with("not updated") { "trouble" } else { "" }>
+                                    <td>{a.to_string()}</td>
+                                    <td>{*st}</td>
+                                    <td><progress max="1000" value=pm.to_string()></progress></td>
+                                    <td>{words.clone()}</td>
+                                </tr>
+                            }).collect_view()}
+                        </tbody>
+                    </table>
+                </div>
+            </div>
+        })
+    }
+}

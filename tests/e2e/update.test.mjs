@@ -1,0 +1,148 @@
+// Browser end-to-end journeys of the Firmware update view against the
+// simulated street the page opens on, run 10 times as fast as the page's
+// clock (`?speed=10`) so that minutes of power line traffic take seconds.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs/promises';
+import { launchChromium, serveDist, watchedPage } from './harness.mjs';
+import { shot, tab } from './journeys.mjs';
+
+let server;
+let base;
+let browser;
+
+before(async () => {
+  ({ server, base } = await serveDist());
+  browser = await launchChromium();
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((r) => (server ? server.close(r) : r()));
+});
+
+const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
+const firmware = (page, n) =>
+  page.locator(`#fleet-table tbody tr[data-address="${lamp(n)}"] td[data-key="firmware"]`);
+
+/** A fresh page on a street of `lamps`, every lamp found and read. */
+async function open(t, lamps = 12) {
+  const context = await browser.newContext({
+    acceptDownloads: true,
+    viewport: { width: 1400, height: 900 },
+  });
+  const page = await watchedPage(t, context);
+  await page.goto(`${base}?speed=10&lamps=${lamps}`);
+  await page.waitForFunction(
+    (n) => {
+      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
+    },
+    lamps,
+    { timeout: 60_000, polling: 250 },
+  );
+  return page;
+}
+
+/** Makes a simulated image of release `release` in the view. */
+async function makeImage(page, release, size = 3000) {
+  await tab(page, 'update');
+  await page.fill('#update-make-release', release);
+  await page.fill('#update-make-size', String(size));
+  await page.click('#update-make');
+  await page.locator('#update-image', { hasText: `release ${release}` }).waitFor();
+}
+
+const summary = (page, text) =>
+  page.locator('#update-summary', { hasText: text }).waitFor({ timeout: 120_000 });
+
+test('update one lamp with a generated image and see its release change', async (t) => {
+  const page = await open(t);
+  await makeImage(page, '1.5');
+  assert.match(await page.textContent('#update-image'), /simulated-1\.5\.bin: 3000 bytes, release 1\.5, CRC-32 [0-9A-F]{8}/);
+  await page.selectOption('#update-targets', `lamp:${lamp(3)}`);
+  await page.click('#update-start');
+  await page.locator('#update-boards tbody tr').first().waitFor();
+  await shot(page, 'update-running');
+  await summary(page, '1 of 1 updated');
+  assert.match(await page.textContent('#update-boards tbody tr'), /updated to 1\.5/);
+  await shot(page, 'update-one');
+  await tab(page, 'street');
+  await page.waitForFunction(
+    (sel) => document.querySelector(sel)?.textContent === '1.5',
+    `#fleet-table tr[data-address="${lamp(3)}"] td[data-key="firmware"]`,
+  );
+  assert.equal(await firmware(page, 4).textContent(), '1.4', 'the others keep theirs');
+});
+
+test('a truncated image is refused before anything is sent', async (t) => {
+  const page = await open(t);
+  await makeImage(page, '1.6', 4000);
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#update-save-image')]);
+  const whole = await fs.readFile(await download.path());
+  assert.equal(whole.length, 4000);
+  await page.setInputFiles('#update-file', {
+    name: 'cut.bin',
+    mimeType: 'application/octet-stream',
+    buffer: whole.subarray(0, 2500),
+  });
+  const note = page.locator('#update-image', { hasText: 'cut.bin refused: truncated' });
+  await note.waitFor();
+  assert.match(await note.textContent(), /the image says 4000 bytes and the file has 2500/);
+  assert.match(await note.getAttribute('class'), /error/);
+  assert.equal(await page.isDisabled('#update-start'), true, 'nothing can be started');
+  assert.equal(await page.locator('#update-progress-card').count(), 0, 'no campaign');
+  await shot(page, 'update-refused');
+  // The whole file is taken.
+  await page.setInputFiles('#update-file', {
+    name: 'whole.bin',
+    mimeType: 'application/octet-stream',
+    buffer: whole,
+  });
+  await page.locator('#update-image', { hasText: 'whole.bin: 4000 bytes, release 1.6' }).waitFor();
+  assert.equal(await page.isDisabled('#update-start'), false);
+});
+
+test('a street of 10 with one lamp unreachable: the others updated, that one reported', async (t) => {
+  const page = await open(t, 10);
+  await page.click(`#fleet-table tbody tr[data-address="${lamp(7)}"]`);
+  await page.click('#lamp-sim-cut');
+  await makeImage(page, '1.7', 2000);
+  await page.selectOption('#update-targets', 'all');
+  await page.click('#update-start');
+  await summary(page, '9 of 10 updated, 1 not');
+  const row = page.locator('#update-boards tbody tr', { hasText: lamp(7) });
+  assert.match(await row.textContent(), /not updated: did not answer/);
+  assert.match(await row.getAttribute('class'), /trouble/);
+  await shot(page, 'update-street');
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#update-export')]);
+  const csv = await fs.readFile(await download.path(), 'utf8');
+  assert.equal(csv.trim().split('\n').length, 11, csv);
+  assert.match(csv, new RegExp(`${lamp(2)},"updated to 1.7"`));
+  assert.match(csv, new RegExp(`${lamp(7)},"not updated: did not answer`));
+});
+
+test('leaving mid-update warns; after a reload the update resumes and finishes', async (t) => {
+  const page = await open(t);
+  await makeImage(page, '1.8', 6000);
+  await page.selectOption('#update-targets', 'all');
+  await page.click('#update-start');
+  await page.waitForFunction(() => Number(document.querySelector('#update-progress')?.value) > 100);
+  const dialogs = [];
+  page.on('dialog', async (d) => {
+    dialogs.push(d.type());
+    await d.accept();
+  });
+  await page.reload();
+  assert.deepEqual(dialogs, ['beforeunload'], 'the page asked before leaving');
+  await tab(page, 'update');
+  await page.locator('#update-saved').waitFor();
+  await shot(page, 'update-saved');
+  await page.click('#update-resume');
+  await summary(page, '12 of 12 updated');
+  await shot(page, 'update-resumed');
+  await page.locator('#update-dismiss').click();
+  await page.locator('#update-saved').waitFor({ state: 'detached' });
+  assert.equal(await page.locator('#update-progress-card').count(), 0);
+});
