@@ -12,8 +12,10 @@
 //!    concentrator sweeps it (reads every 5th lamp, one after another, from
 //!    the nearest to the farthest: 100 reads), against real time, and the
 //!    wall time each read of the sweep costs.
-//! 3. Remote firmware update of 20 lamps with a 20 kB image: the street
-//!    campaign against the same engine lamp by lamp (ratio: how many times
+//! 3. Remote firmware update of one board with a 60 KiB image at B-PSK
+//!    coded and at 8-PSK, against the channel limit and against
+//!    stop-and-wait; of 50 lamps with a 20 kB image, the street campaign
+//!    against the same engine lamp by lamp (ratio: how many times
 //!    faster), in simulated seconds.
 
 use plm_core::app::hid::{self, Hid};
@@ -59,13 +61,99 @@ fn read_all(d: &mut StreetDriver, lamps: usize, step: usize) -> (Vec<Message>, u
 /// Airtime of one application message as a line frame: the line frame's
 /// bytes, the DL CRC (2) and the DL length byte (UM0932 2.3), at B-PSK.
 fn line_airtime(phy: &PhyConfig, m: &Message, broadcast: bool) -> Duration {
+    airtime_at(Modulation::BPsk, phy, m, broadcast)
+}
+
+/// [`line_airtime`] at `modulation`.
+fn airtime_at(modulation: Modulation, phy: &PhyConfig, m: &Message, broadcast: bool) -> Duration {
     let app = if broadcast {
         m.broadcast(street_address(0))
     } else {
         m.to(street_address(1))
     };
     let line = LineFrame::from_app(&app, street_address(0)).emit();
-    airtime(Modulation::BPsk, phy, line.len() + 2 + 1)
+    airtime(modulation, phy, line.len() + 2 + 1)
+}
+
+/// Remote firmware update of one board with a 60 KiB image at
+/// `modulation` (boards and concentrator send with it), the engine paced
+/// to the line (`UpdateConfig::paced`): against the channel limit (the
+/// image's bits at the modulation's bit rate) and against stop-and-wait
+/// (each segment sent and acknowledged before the next: the airtime of
+/// the segment frame and of its acknowledgement, back to back, nothing
+/// else counted).
+fn update_one(modulation: Modulation) {
+    use plm_core::app::rfu::{segment_of, IMAGE_MAX};
+    use plm_core::app::update::{BoardState, Update, UpdateConfig};
+    use plm_sim::line::bit_rate;
+    use plm_sim::rfu::firmware_image;
+    let phy = PhyConfig::decode(object(index::PHY_CONFIG).expect("MIB 01h").default);
+    let new = Release { major: 1, minor: 5 };
+    let image = firmware_image(new, IMAGE_MAX);
+    let segment = |n: usize| {
+        Message::Service(Service::RfuData {
+            campaign: 1,
+            segment: n as u16,
+            data: segment_of(&image, n).to_vec(),
+        })
+    };
+    let full = segment(0);
+    let config = UpdateConfig::paced(airtime_at(modulation, &phy, &full, true));
+    let sim = Sim::new(SimConfig {
+        seed: 5,
+        modulation,
+        ..SimConfig::street(1, Attach::Board)
+    });
+    let mut d = StreetDriver::new(sim, RequesterConfig::default());
+    d.run_for(2 * S);
+    let wall = Instant::now();
+    let start = d.now();
+    let mut u = Update::new(1, new, image.clone(), &[street_address(1)], config).expect("a campaign");
+    // The engine's loop (StreetDriver::update), noting when the image is
+    // across: the swap asked.
+    let mut across = None;
+    while !u.is_done() {
+        let now = d.now();
+        match u.poll(now) {
+            Some(r) => {
+                if matches!(r.message, Message::Service(Service::RfuSwap { .. })) {
+                    across.get_or_insert(now);
+                }
+                let answer = d.request(r, 120 * S);
+                if let Some(plm_core::app::AppEvent::Answered { answer, .. }) = answer {
+                    u.on_answer(d.now(), Ok(answer));
+                } else if let Some(plm_core::app::AppEvent::Failed { reason, .. }) = answer {
+                    u.on_answer(d.now(), Err(reason));
+                }
+            }
+            None => {
+                let until = u.poll_timeout().unwrap_or(now + 100 * MS);
+                d.run_for(until.saturating_sub(now).max(1));
+            }
+        }
+    }
+    let took = (d.now() - start) as f64 / 1e6;
+    let transfer = (across.unwrap_or(d.now()) - start) as f64 / 1e6;
+    let done = u.boards().all(|(_, s)| *s == BoardState::Done);
+    let limit = (image.len() * 8) as f64 / bit_rate(modulation, &phy) as f64;
+    let segments = plm_core::app::rfu::segments(image.len());
+    let ack = airtime_at(modulation, &phy, &full.ack(), false);
+    let stop_and_wait = (0..segments)
+        .map(|n| airtime_at(modulation, &phy, &segment(n), false) + ack)
+        .sum::<Duration>() as f64
+        / 1e6;
+    println!(
+        "remote firmware update of one board, {}-byte image at {modulation:?}: image across \
+         in {transfer:.1} s simulated, channel limit {limit:.1} s, ratio {:.2}; stop-and-wait \
+         at least {stop_and_wait:.1} s, ratio {:.2} (segment gap {} ms; {took:.1} s with the \
+         swap and restart; {}; {:.2} s wall)",
+        image.len(),
+        limit / transfer,
+        stop_and_wait / transfer,
+        config.gap / MS,
+        if done { "updated" } else { "NOT updated" },
+        wall.elapsed().as_secs_f64()
+    );
 }
 
 fn discover_and_read(lamps: usize) {
@@ -175,5 +263,7 @@ fn update(lamps: usize, size: usize) {
 fn main() {
     discover_and_read(100);
     sweep(500, 5);
-    update(20, 20_000);
+    update_one(Modulation::BPskCoded);
+    update_one(Modulation::EightPsk);
+    update(50, 20_000);
 }

@@ -62,6 +62,8 @@ pub struct BoardConfig {
     pub baud: u32,
     /// Seconds the RTC is ahead of virtual midnight at power-on (drift).
     pub clock_offset: u64,
+    /// The modulation its frames go out with.
+    pub modulation: plm_core::st7580::Modulation,
 }
 
 /// A pending MIB frame: who asked, and whether it was a write.
@@ -117,7 +119,10 @@ impl Board {
                     ..HostConfig::default()
                 },
             ),
-            params: TxParams::default(),
+            params: TxParams {
+                modulation: config.modulation,
+                ..TxParams::default()
+            },
             clock_offset: config.clock_offset,
             io_config: 0,
             outputs: 0,

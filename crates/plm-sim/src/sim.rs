@@ -41,6 +41,9 @@ pub struct SimConfig {
     pub peers: Peers,
     /// The lamps of a street's boards.
     pub ballast: BallastConfig,
+    /// The modulation the street's boards (and a concentrator board)
+    /// send with (their firmware's TxParams; B-PSK by default).
+    pub modulation: Modulation,
 }
 
 impl Default for SimConfig {
@@ -53,6 +56,7 @@ impl Default for SimConfig {
             attach: Attach::Modem,
             peers: Peers::Echo,
             ballast: BallastConfig::default(),
+            modulation: Modulation::BPsk,
         }
     }
 }
@@ -325,6 +329,7 @@ impl Sim {
                             ballast,
                             baud: config.baud,
                             clock_offset,
+                            modulation: config.modulation,
                         },
                     )
                 };

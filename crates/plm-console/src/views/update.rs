@@ -7,7 +7,7 @@
 //! from what the browser kept; the results export as CSV.
 
 use super::files::{chosen_file, download, download_bytes, read_bytes};
-use super::widgets::{button, note};
+use super::widgets::{button, note, text_input};
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
 use leptos::prelude::*;
@@ -155,21 +155,15 @@ pub fn UpdateView() -> impl IntoView {
                     <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_file/>
                 </label>
                 <span class="muted">"or make a simulated one: release "</span>
-                <input id="update-make-release" size="5" prop:value=move || make_release.get() on:input=move |ev| make_release.set(event_target_value(&ev))/>
+                {text_input("update-make-release", "", "x.y", Some(5), make_release)}
                 <span class="muted">" bytes "</span>
-                <input id="update-make-size" size="6" prop:value=move || make_size.get() on:input=move |ev| make_size.set(event_target_value(&ev))/>
+                {text_input("update-make-size", "", "", Some(6), make_size)}
                 {button("update-make", "Make image", "a firmware image the simulated boards run", make)}
-                <button
-                    id="update-save-image"
-                    prop:disabled=move || chosen.with(|c| c.is_none())
-                    on:click=move |_| {
-                        if let Some(c) = chosen.get_untracked() {
-                            let _ = download_bytes(&c.name, &c.bytes);
-                        }
+                {button("update-save-image", "Save image file", "", move || {
+                    if let Some(c) = chosen.get_untracked() {
+                        let _ = download_bytes(&c.name, &c.bytes);
                     }
-                >
-                    "Save image file"
-                </button>
+                })}
             </div>
             <p
                 id="update-image"
@@ -202,20 +196,23 @@ pub fn UpdateView() -> impl IntoView {
 fn target_options(street: StreetStore) -> impl IntoView {
     street.version.track();
     let selected = street.selected.with(|s| s.len());
-    let (mut releases, lamps): (Vec<Release>, Vec<(Address, String)>) = street.with_fleet(|f| {
-        (
-            f.values()
-                .filter_map(|l| l.discovered.map(|d| d.firmware))
-                .collect(),
-            f.values()
-                .map(|l| {
-                    let r = l.discovered.map_or("?".into(), |d| d.firmware.to_string());
-                    (l.address, r)
-                })
-                .collect(),
-        )
+    // Each release with its count, in the order first met (a street has
+    // few; no sort is worth its code in the page).
+    let mut releases: Vec<(Release, usize)> = Vec::new();
+    let lamps: Vec<(Address, String)> = street.with_fleet(|f| {
+        f.values()
+            .map(|l| {
+                let r = l.discovered.map(|d| d.firmware);
+                if let Some(r) = r {
+                    match releases.iter_mut().find(|(x, _)| *x == r) {
+                        Some((_, n)) => *n += 1,
+                        None => releases.push((r, 1)),
+                    }
+                }
+                (l.address, r.map_or("?".into(), |r| r.to_string()))
+            })
+            .collect()
     });
-    releases.sort();
     let mut options = vec![("all".to_string(), format!("every lamp ({})", lamps.len()))];
     if selected > 0 {
         options.push((
@@ -223,15 +220,8 @@ fn target_options(street: StreetStore) -> impl IntoView {
             format!("lamps selected in the Street view ({selected})"),
         ));
     }
-    let mut i = 0;
-    while i < releases.len() {
-        let r = releases[i];
-        let n = releases[i..].iter().take_while(|x| **x == r).count();
-        options.push((
-            format!("release:{r}"),
-            format!("lamps on release {r} ({n})"),
-        ));
-        i += n;
+    for (r, n) in releases {
+        options.push((format!("release:{r}"), format!("lamps on release {r} ({n})")));
     }
     for (a, r) in lamps {
         options.push((format!("lamp:{a}"), format!("lamp {a} (release {r})")));

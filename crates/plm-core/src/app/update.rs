@@ -57,6 +57,24 @@ pub struct UpdateConfig {
     pub restarts: u8,
 }
 
+impl UpdateConfig {
+    /// Between two segments: what is left to the line after one (the
+    /// simulated concentrator loses segments with none; 10 ms keeps 5 ms
+    /// in hand there; docs/protocol-notes.md, "The update engine").
+    pub const MARGIN: Duration = 10 * MS;
+
+    /// The default pacing with the gap that a line whose full segment
+    /// frame takes `segment_airtime` to send can carry: the airtime and
+    /// [`UpdateConfig::MARGIN`] (the next frame crossing the USART and
+    /// the modem's turnaround).
+    pub fn paced(segment_airtime: Duration) -> UpdateConfig {
+        UpdateConfig {
+            gap: segment_airtime + Self::MARGIN,
+            ..UpdateConfig::default()
+        }
+    }
+}
+
 impl Default for UpdateConfig {
     fn default() -> Self {
         UpdateConfig {

@@ -1,0 +1,312 @@
+//! The strict JSON parser (RFC 8259): one value, whitespace around it,
+//! nothing else. Errors name the line and column, what was expected and
+//! what was found, for a user who opened the wrong file.
+
+use super::{Json, Object};
+use alloc::string::String;
+use alloc::vec::Vec;
+use core::fmt;
+
+/// Arrays and objects nested deeper than this are refused rather than
+/// risking the stack (serde_json's limit too).
+const MAX_DEPTH: usize = 128;
+
+/// Where a text stops being JSON, and why.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParseError {
+    /// Line, from 1.
+    pub line: usize,
+    /// Column in characters, from 1.
+    pub column: usize,
+    /// What would have been JSON there (`a value`, `` `,` or `]` ``).
+    pub expected: &'static str,
+    /// What is there instead: a character in backquotes, or `the end of
+    /// the text`.
+    pub found: String,
+}
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "line {}, column {}: expected {}, found {}",
+            self.line, self.column, self.expected, self.found
+        )
+    }
+}
+
+/// Reads one JSON value.
+pub fn parse(text: &str) -> Result<Json, ParseError> {
+    let mut p = Parser { text, pos: 0 };
+    let v = p.value(0)?;
+    p.skip_whitespace();
+    if p.pos < text.len() {
+        return Err(p.error("the end of the text"));
+    }
+    Ok(v)
+}
+
+struct Parser<'a> {
+    text: &'a str,
+    /// Byte offset of the next character.
+    pos: usize,
+}
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<u8> {
+        self.text.as_bytes().get(self.pos).copied()
+    }
+
+    fn error(&self, expected: &'static str) -> ParseError {
+        let before = &self.text[..self.pos];
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+        let found = match self.text[self.pos..].chars().next() {
+            Some(c) if c.is_control() => alloc::format!("{c:?}"),
+            Some(c) => alloc::format!("`{c}`"),
+            None => "the end of the text".into(),
+        };
+        ParseError {
+            line,
+            column,
+            expected,
+            found,
+        }
+    }
+
+    fn skip_whitespace(&mut self) {
+        while matches!(self.peek(), Some(b' ' | b'\t' | b'\n' | b'\r')) {
+            self.pos += 1;
+        }
+    }
+
+    /// Consumes `b` after whitespace, or says it was expected.
+    fn expect(&mut self, b: u8, expected: &'static str) -> Result<(), ParseError> {
+        self.skip_whitespace();
+        if self.peek() != Some(b) {
+            return Err(self.error(expected));
+        }
+        self.pos += 1;
+        Ok(())
+    }
+
+    fn value(&mut self, depth: usize) -> Result<Json, ParseError> {
+        self.skip_whitespace();
+        match self.peek() {
+            Some(b'n') => self.literal("null", Json::Null),
+            Some(b't') => self.literal("true", Json::Bool(true)),
+            Some(b'f') => self.literal("false", Json::Bool(false)),
+            Some(b'"') => Ok(Json::String(self.string()?)),
+            Some(b'-' | b'0'..=b'9') => self.number(),
+            Some(b'[' | b'{') if depth == MAX_DEPTH => {
+                Err(self.error("at most 128 nested arrays and objects"))
+            }
+            Some(b'[') => self.array(depth + 1),
+            Some(b'{') => self.object(depth + 1),
+            _ => Err(self.error("a value")),
+        }
+    }
+
+    fn literal(&mut self, word: &'static str, v: Json) -> Result<Json, ParseError> {
+        for &b in word.as_bytes() {
+            if self.peek() != Some(b) {
+                return Err(self.error(word));
+            }
+            self.pos += 1;
+        }
+        Ok(v)
+    }
+
+    fn array(&mut self, depth: usize) -> Result<Json, ParseError> {
+        self.pos += 1;
+        let mut items = Vec::new();
+        self.skip_whitespace();
+        if self.peek() == Some(b']') {
+            self.pos += 1;
+            return Ok(Json::Array(items));
+        }
+        loop {
+            items.push(self.value(depth)?);
+            self.skip_whitespace();
+            match self.peek() {
+                Some(b',') => self.pos += 1,
+                Some(b']') => {
+                    self.pos += 1;
+                    return Ok(Json::Array(items));
+                }
+                _ => return Err(self.error("`,` or `]`")),
+            }
+        }
+    }
+
+    fn object(&mut self, depth: usize) -> Result<Json, ParseError> {
+        self.pos += 1;
+        let mut o = Object::new();
+        self.skip_whitespace();
+        if self.peek() == Some(b'}') {
+            self.pos += 1;
+            return Ok(Json::Object(o));
+        }
+        loop {
+            self.skip_whitespace();
+            if self.peek() != Some(b'"') {
+                return Err(self.error("a key in double quotes"));
+            }
+            let key = self.string()?;
+            self.expect(b':', "`:`")?;
+            // A key given twice keeps its first place and its last value,
+            // as serde_json reads it.
+            o.insert(key, self.value(depth)?);
+            self.skip_whitespace();
+            match self.peek() {
+                Some(b',') => self.pos += 1,
+                Some(b'}') => {
+                    self.pos += 1;
+                    return Ok(Json::Object(o));
+                }
+                _ => return Err(self.error("`,` or `}`")),
+            }
+        }
+    }
+
+    /// `-? (0 | [1-9][0-9]*) (. [0-9]+)? ([eE] [+-]? [0-9]+)?`
+    fn number(&mut self) -> Result<Json, ParseError> {
+        let start = self.pos;
+        if self.peek() == Some(b'-') {
+            self.pos += 1;
+        }
+        match self.peek() {
+            Some(b'0') => self.pos += 1,
+            Some(b'1'..=b'9') => self.digits(),
+            _ => return Err(self.error("a digit")),
+        }
+        let mut whole = true;
+        if self.peek() == Some(b'.') {
+            self.pos += 1;
+            self.digits_after("a digit after `.`")?;
+            whole = false;
+        }
+        if matches!(self.peek(), Some(b'e' | b'E')) {
+            self.pos += 1;
+            if matches!(self.peek(), Some(b'+' | b'-')) {
+                self.pos += 1;
+            }
+            self.digits_after("a digit in the exponent")?;
+            whole = false;
+        }
+        if matches!(self.peek(), Some(b'0'..=b'9')) {
+            // A digit after a leading 0 (`01`).
+            return Err(self.error("the end of the number (no digit after a leading 0)"));
+        }
+        let text = &self.text[start..self.pos];
+        Ok(match text.parse::<i64>() {
+            // `-0` is not how an i64 is written: keep it as text.
+            Ok(n) if whole && text != "-0" => Json::Int(n),
+            _ => Json::Number(text.into()),
+        })
+    }
+
+    fn digits(&mut self) {
+        while matches!(self.peek(), Some(b'0'..=b'9')) {
+            self.pos += 1;
+        }
+    }
+
+    fn digits_after(&mut self, expected: &'static str) -> Result<(), ParseError> {
+        if !matches!(self.peek(), Some(b'0'..=b'9')) {
+            return Err(self.error(expected));
+        }
+        self.digits();
+        Ok(())
+    }
+
+    /// A string from its opening quote.
+    fn string(&mut self) -> Result<String, ParseError> {
+        self.pos += 1;
+        let mut out = String::new();
+        loop {
+            // Runs of plain characters are copied as they are: every byte
+            // that ends one is ASCII, so the slices are whole characters.
+            let run = self.pos;
+            while matches!(self.peek(), Some(b) if b != b'"' && b != b'\\' && b >= 0x20) {
+                self.pos += 1;
+            }
+            out.push_str(&self.text[run..self.pos]);
+            match self.peek() {
+                Some(b'"') => {
+                    self.pos += 1;
+                    return Ok(out);
+                }
+                Some(b'\\') => {
+                    self.pos += 1;
+                    out.push(self.escape()?);
+                }
+                Some(_) => return Err(self.error("`\\` before a control character")),
+                None => return Err(self.error("the closing `\"`")),
+            }
+        }
+    }
+
+    /// The character of an escape, after its `\`.
+    fn escape(&mut self) -> Result<char, ParseError> {
+        let c = match self.peek() {
+            Some(b'"') => '"',
+            Some(b'\\') => '\\',
+            Some(b'/') => '/',
+            Some(b'b') => '\u{8}',
+            Some(b'f') => '\u{c}',
+            Some(b'n') => '\n',
+            Some(b'r') => '\r',
+            Some(b't') => '\t',
+            Some(b'u') => {
+                self.pos += 1;
+                return self.unicode_escape();
+            }
+            _ => return Err(self.error("an escape: one of `\"\\/bfnrt` or `u`")),
+        };
+        self.pos += 1;
+        Ok(c)
+    }
+
+    /// `XXXX` after `\u`, and the low half after a high surrogate.
+    fn unicode_escape(&mut self) -> Result<char, ParseError> {
+        let high = self.hex4()?;
+        let code = match high {
+            0xD800..=0xDBFF => {
+                if !self.text[self.pos..].starts_with("\\u") {
+                    return Err(self.error("`\\u` and the low surrogate after a high one"));
+                }
+                self.pos += 2;
+                let at = self.pos;
+                let low = self.hex4()?;
+                if !(0xDC00..=0xDFFF).contains(&low) {
+                    self.pos = at;
+                    return Err(self.error("a low surrogate (DC00 to DFFF)"));
+                }
+                0x10000 + ((high - 0xD800) << 10) + (low - 0xDC00)
+            }
+            0xDC00..=0xDFFF => {
+                self.pos -= 4;
+                return Err(self.error("a high surrogate before a low one"));
+            }
+            other => other,
+        };
+        // Whole surrogate pairs and non-surrogates are always characters.
+        char::from_u32(code).ok_or_else(|| self.error("a character"))
+    }
+
+    fn hex4(&mut self) -> Result<u32, ParseError> {
+        let mut n = 0;
+        for _ in 0..4 {
+            let d = match self.peek() {
+                Some(b @ b'0'..=b'9') => b - b'0',
+                Some(b @ b'a'..=b'f') => b - b'a' + 10,
+                Some(b @ b'A'..=b'F') => b - b'A' + 10,
+                _ => return Err(self.error("4 hex digits after `\\u`")),
+            };
+            n = n * 16 + u32::from(d);
+            self.pos += 1;
+        }
+        Ok(n)
+    }
+}
