@@ -108,7 +108,8 @@ fn update_one(modulation: Modulation) {
     d.run_for(2 * S);
     let wall = Instant::now();
     let start = d.now();
-    let mut u = Update::new(1, new, image.clone(), &[street_address(1)], config).expect("a campaign");
+    let mut u =
+        Update::new(1, new, image.clone(), &[street_address(1)], config).expect("a campaign");
     // The engine's loop (StreetDriver::update), noting when the image is
     // across: the swap asked.
     let mut across = None;

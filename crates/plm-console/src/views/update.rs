@@ -221,7 +221,10 @@ fn target_options(street: StreetStore) -> impl IntoView {
         ));
     }
     for (r, n) in releases {
-        options.push((format!("release:{r}"), format!("lamps on release {r} ({n})")));
+        options.push((
+            format!("release:{r}"),
+            format!("lamps on release {r} ({n})"),
+        ));
     }
     for (a, r) in lamps {
         options.push((format!("lamp:{a}"), format!("lamp {a} (release {r})")));
