@@ -96,7 +96,12 @@ impl Port for Rfc2217Port {
 }
 
 /// A local serial device.
-struct SerialDevice(Box<dyn serialport::SerialPort>);
+struct SerialDevice {
+    port: Box<dyn serialport::SerialPort>,
+    /// Why RTS cannot be set, if it cannot (a pseudo-terminal has no
+    /// modem lines: fine for a board's USART, not for T_REQ).
+    no_rts: Option<String>,
+}
 
 impl SerialDevice {
     fn open(path: &str, baud: u32) -> serialport::Result<SerialDevice> {
@@ -107,8 +112,11 @@ impl SerialDevice {
             .flow_control(serialport::FlowControl::None)
             .timeout(Duration::from_millis(5))
             .open()?;
-        port.write_request_to_send(false)?;
-        Ok(SerialDevice(port))
+        let no_rts = port
+            .write_request_to_send(false)
+            .err()
+            .map(|e| e.description);
+        Ok(SerialDevice { port, no_rts })
     }
 }
 
@@ -118,15 +126,15 @@ fn io_error(e: serialport::Error) -> io::Error {
 
 impl Port for SerialDevice {
     fn write(&mut self, bytes: &[u8]) -> io::Result<()> {
-        self.0.write_all(bytes)
+        self.port.write_all(bytes)
     }
 
     fn read(&mut self, wait: Duration) -> io::Result<Vec<u8>> {
-        self.0
+        self.port
             .set_timeout(wait.max(Duration::from_millis(1)))
             .map_err(io_error)?;
         let mut buf = [0u8; 1024];
-        match self.0.read(&mut buf) {
+        match self.port.read(&mut buf) {
             Ok(0) => Err(io::Error::new(
                 ErrorKind::UnexpectedEof,
                 "the device is gone (unplugged?)",
@@ -143,7 +151,13 @@ impl Port for SerialDevice {
     fn set_rts(&mut self, asserted: bool) -> io::Result<()> {
         // The bytes written before must be on the wire first (tcdrain):
         // a host releases T_REQ after the STX of its frame has left.
-        self.0.flush()?;
-        self.0.write_request_to_send(asserted).map_err(io_error)
+        if let Some(why) = &self.no_rts {
+            return Err(io::Error::other(format!(
+                "this device's RTS line cannot be set ({why}); a bare modem needs it for T_REQ \
+                 (is it a pseudo-terminal? use --via board, or an adapter with RTS)"
+            )));
+        }
+        self.port.flush()?;
+        self.port.write_request_to_send(asserted).map_err(io_error)
     }
 }

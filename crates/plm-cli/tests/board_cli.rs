@@ -467,3 +467,84 @@ fn a_bare_modem_as_the_concentrator() {
     assert_eq!(d.code, Some(0), "{d:?}");
     server.interrupt();
 }
+
+/// A serial device: a pseudo-terminal whose other end the test bridges to
+/// `plm sim`'s concentrator board (its RFC 2217 data, IAC undone both
+/// ways). `plm board` opens `/dev/pts/N` with the `serialport` crate,
+/// 8N1, and reads a lamp and dims one; a pseudo-terminal has no RTS, so
+/// `--via modem` is refused with exit 3.
+#[cfg(unix)]
+#[test]
+fn a_serial_device() {
+    use plm_cli::rfc2217::client::Client;
+    use serialport::SerialPort;
+    use std::io::{Read, Write};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let mut server = street("2");
+    let dir = Scratch::new("serial");
+    let (mut master, slave) = serialport::TTYPort::pair().expect("a pseudo-terminal");
+    let device = slave.name().expect("the pseudo-terminal's name");
+    // `plm board` opens it by its name; the test keeps only the master.
+    drop(slave);
+    master.set_timeout(Duration::from_millis(5)).unwrap();
+    let mut link = Client::connect(&server.addr).unwrap();
+    server.line_containing("connected");
+    let stop = Arc::new(AtomicBool::new(false));
+    let bridge = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 512];
+            while !stop.load(Ordering::SeqCst) {
+                match master.read(&mut buf) {
+                    Ok(n) if n > 0 => link.send_data(&buf[..n]).unwrap(),
+                    // No reader on the other side yet (EIO), or nothing.
+                    Ok(_) | Err(_) => {}
+                }
+                link.pump(Duration::from_millis(2)).unwrap();
+                link.telnet.clear();
+                let data = link.take_data();
+                if !data.is_empty() {
+                    // Lost if nobody has the device open: as on a wire.
+                    let _ = master.write_all(&data);
+                }
+            }
+        })
+    };
+
+    let s = plm(
+        &dir,
+        "status",
+        &["board", "--port", &device, "status", &lamp(1)],
+    );
+    assert_eq!(s.code, Some(0), "{s:?}");
+    assert!(s.out.contains("firmware     1.4"), "{}", s.out);
+    let d = plm(
+        &dir,
+        "dim",
+        &["board", "--port", &device, "dim", &lamp(2), "30"],
+    );
+    assert_eq!(d.code, Some(0), "{d:?}");
+    assert!(d.out.contains("dimmed to 30 %"), "{}", d.out);
+    let m = plm(
+        &dir,
+        "modem",
+        &[
+            "board",
+            "--port",
+            &device,
+            "--via",
+            "modem",
+            "status",
+            &lamp(1),
+        ],
+    );
+    assert_eq!(m.code, Some(3), "{m:?}");
+    assert!(m.err.contains("RTS"), "{}", m.err);
+
+    stop.store(true, Ordering::SeqCst);
+    bridge.join().unwrap();
+    server.line_containing("disconnected");
+    server.interrupt();
+}

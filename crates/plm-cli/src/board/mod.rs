@@ -274,8 +274,16 @@ fn connect(args: &BoardArgs) -> Result<Driver, Failure> {
     // Ctrl-C stops at the driver's next turn (an update saves its state
     // first).
     ctrlc::set_handler(|| driver::INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst))
-        .map_err(|e| Failure::port(format!("cannot catch Ctrl-C: {e}")))?;
-    let port = port::open(url, args.baud).map_err(Failure::port)?;
+        .map_err(|e| Failure {
+            code: exit::FAILED,
+            message: format!("cannot catch Ctrl-C: {e}"),
+        })?;
+    let mut port = port::open(url, args.baud).map_err(Failure::port)?;
+    if args.via == Via::Modem {
+        // T_REQ is RTS: a port without it cannot drive a bare modem.
+        port.set_rts(false)
+            .map_err(|e| Failure::port(format!("cannot use {url} with --via modem: {e}")))?;
+    }
     let config = RequesterConfig::default();
     let conc = match args.via {
         Via::Board => Concentrator::usart(config),
