@@ -9,14 +9,14 @@ use serde_json::{json, Map, Value};
 
 /// Discovers the boards; prints each as it is found.
 pub fn discover(d: &mut Driver, window: u8, rounds: u8, json: bool) -> Result<u8, Failure> {
-    eprintln!(
+    tell!(
         "plm board: discovering (first window {window} s; the line is quiet for a round \
          before it ends)"
     );
     let started = std::time::Instant::now();
     let found = d.discover(session(), window, rounds, |address, info| {
         if json {
-            println!(
+            say!(
                 "{}",
                 json!({
                     "address": address.to_string(),
@@ -26,23 +26,25 @@ pub fn discover(d: &mut Driver, window: u8, rounds: u8, json: bool) -> Result<u8
                 })
             );
         } else {
-            println!(
+            say!(
                 "{address}  firmware {}  stack {}  SNR {} dB",
-                info.firmware, info.stack, info.snr
+                info.firmware,
+                info.stack,
+                info.snr
             );
         }
     })?;
     let n = found.found().len();
     let secs = started.elapsed().as_secs();
     if n == 0 {
-        eprintln!(
+        tell!(
             "plm board: no board answered in {} round(s), {secs} s: are the boards powered, \
              and is the port the concentrator's (--via)?",
             found.round()
         );
         return Ok(exit::FAILED);
     }
-    eprintln!(
+    tell!(
         "plm board: {n} board{} found in {} round(s), {secs} s",
         if n == 1 { "" } else { "s" },
         found.round()
@@ -101,12 +103,12 @@ pub fn status(d: &mut Driver, node: Address, json: bool) -> Result<u8, Failure> 
     if silent {
         let why = release.as_ref().err().cloned().unwrap_or_default();
         if json {
-            println!(
+            say!(
                 "{}",
                 json!({"address": node.to_string(), "answered": false, "error": why})
             );
         } else {
-            eprintln!("plm board: {why}");
+            tell!("plm board: {why}");
         }
         return Ok(exit::FAILED);
     }
@@ -183,10 +185,10 @@ pub fn status(d: &mut Driver, node: Address, json: bool) -> Result<u8, Failure> 
         if !errors.is_empty() {
             obj.insert("errors".into(), Value::Object(errors));
         }
-        println!("{}", Value::Object(obj));
+        say!("{}", Value::Object(obj));
     } else {
         for l in lines {
-            println!("{l}");
+            say!("{l}");
         }
     }
     Ok(if unanswered == 0 {
@@ -302,7 +304,7 @@ pub fn dim(d: &mut Driver, target: Target, level: u8, json: bool) -> Result<u8, 
         (other, _) => (false, format!("unexpected: {other:?}")),
     };
     if json {
-        println!(
+        say!(
             "{}",
             json!({
                 "target": address.map_or("all".into(), |a| a.to_string()),
@@ -312,10 +314,10 @@ pub fn dim(d: &mut Driver, target: Target, level: u8, json: bool) -> Result<u8, 
             })
         );
     } else if ok {
-        println!("{words}");
+        say!("{words}");
     }
     if !ok {
-        eprintln!("plm board: {words}");
+        tell!("plm board: {words}");
     }
     Ok(if ok { exit::OK } else { exit::FAILED })
 }

@@ -8,6 +8,22 @@
 //! module only drives them on the wall clock ([`driver`]) and says what
 //! happened in words (or JSON lines).
 
+/// `println!` that does not panic when stdout is closed (`| head`).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
+/// `eprintln!` that does not panic when stderr is closed.
+macro_rules! tell {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($t)*);
+    }};
+}
+
 pub mod driver;
 mod info;
 mod rfu;
@@ -238,7 +254,7 @@ pub fn run(args: BoardArgs) -> u8 {
     match dispatch(args) {
         Ok(code) => code,
         Err(f) => {
-            eprintln!("plm board: {}", f.message);
+            tell!("plm board: {}", f.message);
             f.code
         }
     }

@@ -52,7 +52,7 @@ pub fn write_image(args: &ImageArgs) -> Result<u8, Failure> {
         .map_err(|why| Failure::input(format!("the image made is not good: {why} (a bug)")))?;
     std::fs::write(&args.output, &bytes)
         .map_err(|e| Failure::input(format!("cannot write {}: {e}", args.output.display())))?;
-    println!(
+    say!(
         "{}: simulated firmware image, release {}, {} bytes, CRC-32 {:08X} (campaign {})",
         args.output.display(),
         info.version,
@@ -136,7 +136,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
     let mut d = connect(args)?;
     let mut u = match saved {
         Some(saved) => {
-            eprintln!("plm board: resuming the update saved in {shown}");
+            tell!("plm board: resuming the update saved in {shown}");
             Update::resume(bytes, &saved, d.now()).map_err(Failure::input)?
         }
         None => {
@@ -152,7 +152,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
                 t
             };
             if targets.is_empty() {
-                eprintln!("plm board: no board answered the discovery: nothing to update");
+                tell!("plm board: no board answered the discovery: nothing to update");
                 return Ok(exit::FAILED);
             }
             let config = UpdateConfig {
@@ -164,7 +164,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
         }
     };
     let h = u.header();
-    eprintln!(
+    tell!(
         "plm board: campaign {}: {name}, release {}, {} bytes ({} segments), CRC-32 {:08X}, \
          to {} board{}; progress saved in {shown}",
         h.campaign,
@@ -213,7 +213,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
         .count();
     for ((address, words), (_, s)) in report.iter().zip(u.boards()) {
         if args.json {
-            println!(
+            say!(
                 "{}",
                 json!({
                     "address": address.to_string(),
@@ -222,15 +222,13 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
                 })
             );
         } else {
-            println!("{address}  {words}");
+            say!("{address}  {words}");
         }
     }
     if let Err(e) = std::fs::remove_file(&state.path) {
-        eprintln!(
-            "plm board: the update is over but its state file {shown} could not be removed: {e}"
-        );
+        tell!("plm board: the update is over but its state file {shown} could not be removed: {e}");
     }
-    eprintln!(
+    tell!(
         "plm board: {updated} of {} board{} updated to {}",
         report.len(),
         if report.len() == 1 { "" } else { "s" },
@@ -245,9 +243,9 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
 
 /// `--all`: the boards a discovery finds.
 fn find_boards(d: &mut Driver) -> Result<Vec<Address>, Failure> {
-    eprintln!("plm board: discovering the boards to update");
+    tell!("plm board: discovering the boards to update");
     let found = d.discover(session(), 2, 40, |a, info| {
-        eprintln!("plm board: found {a} (firmware {})", info.firmware);
+        tell!("plm board: found {a} (firmware {})", info.firmware);
     })?;
     Ok(found.found().iter().map(|(a, _)| *a).collect())
 }
@@ -336,7 +334,7 @@ impl Progress {
             }
             None if self.last_line.elapsed() >= PLAIN_EVERY => {
                 self.last_line = Instant::now();
-                eprintln!("plm board: {line}");
+                tell!("plm board: {line}");
             }
             None => {}
         }
