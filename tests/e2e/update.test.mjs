@@ -65,7 +65,7 @@ test('update one lamp with a generated image and see its release change', async 
   await page.click('#update-start');
   await page.locator('#update-boards tbody tr').first().waitFor();
   await shot(page, 'update-running');
-  await summary(page, '1 of 1 updated');
+  await summary(page, 'to 1 lamp(s): 1 updated, 0 not updated · took');
   assert.match(await page.textContent('#update-boards tbody tr'), /updated to 1\.5/);
   await shot(page, 'update-one');
   await tab(page, 'street');
@@ -111,16 +111,16 @@ test('a street of 10 with one lamp unreachable: the others updated, that one rep
   await makeImage(page, '1.7', 2000);
   await page.selectOption('#update-targets', 'all');
   await page.click('#update-start');
-  await summary(page, '9 of 10 updated, 1 not');
+  await summary(page, 'to 10 lamp(s): 9 updated, 1 not updated · took');
   const row = page.locator('#update-boards tbody tr', { hasText: lamp(7) });
-  assert.match(await row.textContent(), /not updated: did not answer/);
+  assert.match(await row.textContent(), /not updated: .*did not answer/);
   assert.match(await row.getAttribute('class'), /trouble/);
   await shot(page, 'update-street');
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#update-export')]);
   const csv = await fs.readFile(await download.path(), 'utf8');
   assert.equal(csv.trim().split('\n').length, 11, csv);
   assert.match(csv, new RegExp(`${lamp(2)},"updated to 1.7"`));
-  assert.match(csv, new RegExp(`${lamp(7)},"not updated: did not answer`));
+  assert.match(csv, new RegExp(`${lamp(7)},"not updated: .*did not answer`));
 });
 
 test('leaving mid-update warns; after a reload the update resumes and finishes', async (t) => {
@@ -137,10 +137,12 @@ test('leaving mid-update warns; after a reload the update resumes and finishes',
   await page.reload();
   assert.deepEqual(dialogs, ['beforeunload'], 'the page asked before leaving');
   await tab(page, 'update');
-  await page.locator('#update-saved').waitFor();
+  const banner = page.locator('#update-saved');
+  await banner.waitFor();
+  assert.match(await banner.textContent(), /release 1\.8 to 12 lamp\(s\), 6000-byte image/);
   await shot(page, 'update-saved');
   await page.click('#update-resume');
-  await summary(page, '12 of 12 updated');
+  await summary(page, 'to 12 lamp(s): 12 updated, 0 not updated · took');
   await shot(page, 'update-resumed');
   await page.locator('#update-dismiss').click();
   await page.locator('#update-saved').waitFor({ state: 'detached' });

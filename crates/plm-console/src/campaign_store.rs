@@ -31,6 +31,11 @@ pub fn save(s: &mut StreetSession) {
     store(PROGRESS, Some(&progress));
 }
 
+/// Whether a campaign is kept (cheap: the image is not read).
+pub fn has_saved() -> bool {
+    load(PROGRESS).is_some()
+}
+
 /// The campaign saved, if any: its image and its progress.
 pub fn saved() -> Option<(Vec<u8>, Vec<u8>)> {
     let image = hex::parse(&load(IMAGE)?).ok()?;
@@ -42,4 +47,21 @@ pub fn saved() -> Option<(Vec<u8>, Vec<u8>)> {
 pub fn discard() {
     store(PROGRESS, None);
     store(IMAGE, None);
+}
+
+/// The campaign kept, in words (`release 1.8 to 12 lamp(s), 6000-byte
+/// image`), or why it cannot be read.
+pub fn describe() -> String {
+    let Some((image, progress)) = saved() else {
+        return "the update kept cannot be read".into();
+    };
+    match plm_core::app::update::Update::resume(image, &progress, 0) {
+        Ok(u) => format!(
+            "release {} to {} lamp(s), {}-byte image",
+            u.header().version,
+            u.boards().count(),
+            u.header().size
+        ),
+        Err(e) => format!("the update kept cannot be resumed: {e}"),
+    }
 }

@@ -285,7 +285,7 @@ fn drive(
             }
             state.save(u)?;
         }
-        progress.show(u);
+        progress.show(u, d.now());
         if interrupted() {
             return Err(Failure::interrupted());
         }
@@ -325,8 +325,8 @@ impl Progress {
         }
     }
 
-    fn show(&mut self, u: &Update) {
-        let (line, permille) = self.line(u);
+    fn show(&mut self, u: &Update, now: plm_core::time::Instant) {
+        let (line, permille) = self.line(u, now);
         match &self.bar {
             Some(bar) => {
                 bar.set_position(permille);
@@ -341,7 +341,7 @@ impl Progress {
     }
 
     /// The words, and the average of the boards' progress in permille.
-    fn line(&self, u: &Update) -> (String, u64) {
+    fn line(&self, u: &Update, now: plm_core::time::Instant) -> (String, u64) {
         let total = u.boards().count();
         let (mut done, mut failed) = (0, 0);
         for (_, s) in u.boards() {
@@ -354,7 +354,7 @@ impl Progress {
         let permille = (0..total).map(|i| u.permille(i) as u64).sum::<u64>() / total.max(1) as u64;
         let secs = self.started.elapsed().as_secs_f64().max(0.001);
         let rate = (u.bytes_sent() - self.sent_before.min(u.bytes_sent())) as f64 / secs;
-        let left = u.time_left() / 1_000_000;
+        let left = u.time_left(now) / 1_000_000;
         (
             format!(
                 "{}.{} % · {done}/{total} boards updated, {failed} failed · {rate:.0} B/s · about {} left",

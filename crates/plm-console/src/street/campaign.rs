@@ -17,6 +17,8 @@ pub struct Campaign {
     pub paused: bool,
     /// When it started or resumed, on the session's clock.
     pub since: Instant,
+    /// When it was over.
+    pub ended: Option<Instant>,
     /// A request of the engine is under way.
     in_flight: bool,
     /// The sweep ran before: it runs again when the update is over.
@@ -64,6 +66,7 @@ impl StreetSession {
             update,
             paused: false,
             since: self.now(),
+            ended: None,
             in_flight: false,
             sweep_was_on,
         });
@@ -160,6 +163,7 @@ impl StreetSession {
             .map(|(a, _)| a)
             .collect();
         let sweep = c.sweep_was_on;
+        let now = self.now();
         for a in done {
             if let Some(d) = self.lamp(a).discovered.as_mut() {
                 d.firmware = version;
@@ -172,6 +176,7 @@ impl StreetSession {
         }
         if let Some(c) = self.campaign.as_mut() {
             c.sweep_was_on = false;
+            c.ended.get_or_insert(now);
         }
     }
 }

@@ -122,28 +122,35 @@ pub fn UpdateView() -> impl IntoView {
             Err(e) => format!("nothing sent: {e}"),
         }));
     };
-    let saved = RwSignal::new(campaign_store::saved());
+    // A campaign kept in storage and not running here: after a reload, or
+    // a new connection (the cable pulled and plugged in again).
+    let discarded = RwSignal::new(0u32);
+    let cut_short = move || {
+        street.campaign.track();
+        street.port.track();
+        discarded.track();
+        campaign_store::has_saved() && running().is_none()
+    };
     let resume = move || {
-        let Some((image, progress)) = saved.get_untracked() else {
-            return;
+        let r = match campaign_store::saved() {
+            Some((image, progress)) => street.act(|s| s.resume_update(image, &progress)),
+            None => Err("the browser kept no update".into()),
         };
-        let r = street.act(|s| s.resume_update(image, &progress));
         message.set(Some(match r {
             Ok(()) => "update resumed where it was saved".into(),
             Err(e) => format!("cannot resume: {e}"),
         }));
-        saved.set(None);
     };
     let discard = move || {
         campaign_store::discard();
-        saved.set(None);
+        discarded.update(|n| *n += 1);
     };
 
     view! {
         <div class="update">
-            {move || (saved.with(|s| s.is_some()) && running().is_none()).then(|| view! {
+            {move || cut_short().then(|| view! {
                 <div class="alerts" id="update-saved" role="alert">
-                    <b>"An update was cut short (page closed or reloaded, cable pulled). "</b>
+                    <b>{format!("An update was cut short (page closed or reloaded, cable pulled): {}. ", campaign_store::describe())}</b>
                     "Resume it: boards that hold segments keep them; every board's state is asked again. "
                     {button("update-resume", "Resume update", "", resume)}
                     {button("update-discard", "Discard", "the boards keep what they run; segments they hold are dropped at the next update", discard)}
@@ -186,7 +193,7 @@ pub fn UpdateView() -> impl IntoView {
                     "Start update"
                 </button>
             </div>
-            {note("update-message", "message", message)}
+            {move || message.with(|m| m.is_some()).then(|| note("update-message", "message", message))}
             <Progress/>
         </div>
     }
@@ -241,11 +248,21 @@ type Line = (Address, &'static str, u16, String);
 /// What the progress card shows, read from the campaign at once.
 struct Snapshot {
     lines: Vec<Line>,
-    done: usize,
-    failed: usize,
+    /// Segments held over every board, thousandths.
+    overall: usize,
     paused: bool,
     over: bool,
     summary: String,
+}
+
+/// `µs` as `2 min 10 s` or `40 s`.
+fn duration(us: u64) -> String {
+    let s = us / 1_000_000;
+    if s >= 120 {
+        format!("{} min {} s", s / 60, s % 60)
+    } else {
+        format!("{s} s")
+    }
 }
 
 fn snapshot(street: StreetStore) -> Option<Snapshot> {
@@ -266,25 +283,28 @@ fn snapshot(street: StreetStore) -> Option<Snapshot> {
             .iter()
             .filter(|l| l.3.starts_with("not updated"))
             .count();
-        let elapsed = now.saturating_sub(c.since).max(1);
-        let rate = u.bytes_sent() * 1_000_000 / elapsed;
-        let left = u.time_left() / 1_000_000;
-        let summary = format!(
-            "release {}: {done} of {} updated, {failed} not · {rate} B/s · {}",
+        let overall = lines.iter().map(|l| l.2 as usize).sum::<usize>() / lines.len().max(1);
+        let head = format!(
+            "release {} to {} lamp(s): {done} updated, {failed} not updated",
             u.header().version,
-            lines.len(),
-            if u.is_done() {
-                "over".to_string()
-            } else if left >= 120 {
-                format!("about {} min left", left.div_ceil(60))
-            } else {
-                format!("about {left} s left")
-            }
+            lines.len()
         );
+        let summary = match c.ended {
+            Some(end) => format!("{head} · took {}", duration(end.saturating_sub(c.since))),
+            None => {
+                let elapsed = now.saturating_sub(c.since).max(1);
+                format!(
+                    "{head} · {} % · {} B/s · about {} left{}",
+                    overall / 10,
+                    u.bytes_sent() * 1_000_000 / elapsed,
+                    duration(u.time_left(now)),
+                    if c.paused { " · paused" } else { "" }
+                )
+            }
+        };
         Some(Snapshot {
             lines,
-            done,
-            failed,
+            overall,
             paused: c.paused,
             over: u.is_done(),
             summary,
@@ -307,13 +327,11 @@ fn Progress() -> impl IntoView {
     };
     move || {
         let s = snapshot(street)?;
-        let total = s.lines.len().max(1);
-        let overall: usize = s.lines.iter().map(|l| l.2 as usize).sum::<usize>() / total;
-        let (paused, over) = (s.paused, s.over);
+        let (paused, over, overall) = (s.paused, s.over, s.overall);
         Some(view! {
             <div class="card" id="update-progress-card">
                 <p id="update-summary"><b>{s.summary.clone()}</b></p>
-                <progress id="update-progress" max="1000" value=overall.to_string()></progress>
+                <progress id="update-progress" class="wide" max="1000" value=overall.to_string()></progress>
                 <div class="toolbar">
                     {(!over).then(|| button(
                         "update-pause",
@@ -329,7 +347,6 @@ fn Progress() -> impl IntoView {
                     ))}
                     {over.then(|| button("update-export", "Export results (CSV)", "", export))}
                     {over.then(|| button("update-dismiss", "Close", "", move || street.act(|x| x.dismiss_update())))}
-                    <span class="muted">{format!("{} updated, {} not updated", s.done, s.failed)}</span>
                 </div>
                 <div class="table-wrap">
                     <table class="log" id="update-boards">

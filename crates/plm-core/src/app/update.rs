@@ -272,36 +272,42 @@ impl Update {
         (held * 1000 / count.max(1)) as u16
     }
 
-    /// What is left, at the engine's own pace: the segments still to
-    /// broadcast or repair, a status per board still receiving, and a
-    /// swap and restart per board not swapped yet.
-    pub fn time_left(&self) -> Duration {
+    /// What is left at `now`, at the engine's own pace: the segments
+    /// still to broadcast or repair, a status per board still receiving,
+    /// a swap per board not swapped yet, and the restart of the last one.
+    pub fn time_left(&self, now: Instant) -> Duration {
+        if self.is_done() {
+            return 0;
+        }
         let broadcast = match self.phase {
             Phase::Announce => self.header.segments(),
             Phase::Broadcast(n) => self.header.segments() - n.min(self.header.segments()),
             _ => 0,
         };
         let mut segments = broadcast as u64;
-        let mut asks = 0;
-        let mut swaps = 0;
+        let (mut asks, mut swaps) = (0, 0);
+        let mut restart_ends = 0;
         for t in &self.targets {
             match &t.state {
-                BoardState::Announcing => asks += 2,
+                BoardState::Announcing => (asks, swaps) = (asks + 2, swaps + 1),
                 BoardState::Receiving { missing, .. } => {
                     segments += missing.len() as u64;
-                    asks += 1;
+                    (asks, swaps) = (asks + 1, swaps + 1);
                 }
                 BoardState::Complete => swaps += 1,
+                BoardState::Restarting(at) => {
+                    restart_ends = restart_ends.max(at + self.config.restart)
+                }
                 _ => {}
             }
         }
-        let restarting = self
-            .targets
-            .iter()
-            .any(|t| matches!(t.state, BoardState::Restarting(_)));
-        segments * self.config.gap
-            + (asks + swaps) * 1_000 * MS
-            + (swaps + restarting as u64) * self.config.restart
+        let sending = segments * self.config.gap + (asks + swaps) * 1_000 * MS;
+        let restart = if swaps > 0 {
+            self.config.restart
+        } else {
+            restart_ends.saturating_sub(now)
+        };
+        sending + restart
     }
 
     /// When [`Update::poll`] may have something again, if it waits for
@@ -443,11 +449,13 @@ impl Update {
                         return self.ask(b, Service::RfuSwap { campaign, crc });
                     }
                     let restart = self.config.restart;
-                    let back = self.first(now, |s| match s {
-                        BoardState::Restarting(at) if now >= at + restart => Some(()),
-                        _ => None,
+                    // Restarted, or done before a resume: its release is read.
+                    let back = self.targets.iter().position(|t| {
+                        t.not_before <= now
+                            && matches!(t.state, BoardState::Restarting(at)
+                                if t.rechecked || now >= at + restart)
                     });
-                    if let Some((b, ())) = back {
+                    if let Some(b) = back {
                         return self.ask(b, Service::FwRelGet);
                     }
                     match self.next_ready(|s| match s {
@@ -524,7 +532,7 @@ impl Update {
             return;
         }
         self.targets[b].state = match (state, answer) {
-            (state, Err(why)) => self.silent(b, now, state, format!("did not answer: {why}")),
+            (state, Err(why)) => self.silent(b, now, state, why),
             (BoardState::Announcing, Ok(Message::Ack { .. })) => BoardState::Receiving {
                 missing: Vec::new(),
                 asked: 0,
@@ -617,7 +625,7 @@ impl Update {
                     BoardState::Done => format!("updated to {}", self.header.version),
                     BoardState::Aborted => "not updated: the update was aborted".into(),
                     BoardState::Failed(why) => format!("not updated: {why}"),
-                    other => format!("in progress: {}", other.words()),
+                    _ => "in progress".into(),
                 };
                 (t.address, words)
             })

@@ -142,9 +142,9 @@ impl Update {
                 }
                 2 => BoardState::Complete,
                 3 => BoardState::Restarting(now),
-                // Read back again: the board may have been replaced, or
-                // its trial cut short, while nobody watched.
-                4 => BoardState::Restarting(now.saturating_sub(config.restart)),
+                // Read back at once (`rechecked`): the board may have been
+                // replaced, or its trial cut short, while nobody watched.
+                4 => BoardState::Restarting(now),
                 5 => BoardState::Aborted,
                 6 => {
                     let n = r.u16()? as usize;
