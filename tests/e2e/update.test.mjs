@@ -67,6 +67,8 @@ test('update one lamp with a generated image and see its release change', async 
   await shot(page, 'update-running');
   await summary(page, 'to 1 lamp(s): 1 updated, 0 not updated · took');
   assert.match(await page.textContent('#update-boards tbody tr'), /updated to 1\.5/);
+  // The target list was rebuilt as the fleet changed; the choice stays.
+  assert.equal(await page.inputValue('#update-targets'), `lamp:${lamp(3)}`);
   await shot(page, 'update-one');
   await tab(page, 'street');
   await page.waitForFunction(

@@ -182,7 +182,7 @@ pub fn UpdateView() -> impl IntoView {
                 <label>
                     "Lamps "
                     <select id="update-targets" on:change=move |ev| choice.set(event_target_value(&ev))>
-                        {move || target_options(street)}
+                        {move || target_options(street, choice)}
                     </select>
                 </label>
                 <button
@@ -199,8 +199,9 @@ pub fn UpdateView() -> impl IntoView {
     }
 }
 
-/// The target list: all, the selection, each release, each lamp.
-fn target_options(street: StreetStore) -> impl IntoView {
+/// The target list: all, the selection, each release, each lamp. Rebuilt
+/// when the fleet changes, with the choice made kept selected.
+fn target_options(street: StreetStore, choice: RwSignal<String>) -> impl IntoView {
     street.version.track();
     let selected = street.selected.with(|s| s.len());
     // Each release with its count, in the order first met (a street has
@@ -236,9 +237,13 @@ fn target_options(street: StreetStore) -> impl IntoView {
     for (a, r) in lamps {
         options.push((format!("lamp:{a}"), format!("lamp {a} (release {r})")));
     }
+    let current = choice.get_untracked();
     options
         .into_iter()
-        .map(|(value, label)| view! { <option value=value>{label}</option> })
+        .map(|(value, label)| {
+            let selected = value == current;
+            view! { <option value=value selected=selected>{label}</option> }
+        })
         .collect_view()
 }
 
