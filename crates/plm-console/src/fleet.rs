@@ -5,8 +5,8 @@
 use crate::street::Lamp;
 use plm_core::app::hid::LampState;
 use plm_core::app::Address;
+use plm_core::json::{self, Json};
 use plm_core::time::Instant;
-use serde_json::json;
 
 /// The columns, in order: (key, header).
 pub const COLUMNS: &[(&str, &str)] = &[
@@ -141,21 +141,21 @@ pub fn to_csv(rows: &[Row]) -> String {
 
 /// The rows as a JSON array of objects keyed by column.
 pub fn to_json(rows: &[Row]) -> String {
-    let v: Vec<_> = rows
+    let v = rows
         .iter()
         .map(|r| {
-            let mut o = serde_json::Map::new();
-            o.insert("address".into(), json!(r.address.to_string()));
-            o.insert("firmware".into(), json!(r.firmware));
-            o.insert("state".into(), json!(r.state));
-            o.insert("trouble".into(), json!(r.trouble));
+            let mut o = json::Object::new();
+            o.insert("address", Json::from(r.address.to_string()));
+            o.insert("firmware", Json::from(r.firmware.as_str()));
+            o.insert("state", Json::from(r.state.as_str()));
+            o.insert("trouble", Json::from(r.trouble));
             for (k, v) in &r.numbers {
-                o.insert((*k).into(), json!(v));
+                o.insert(*k, Json::from(*v));
             }
-            serde_json::Value::Object(o)
+            Json::Object(o)
         })
         .collect();
-    serde_json::to_string_pretty(&v).unwrap_or_default()
+    Json::Array(v).pretty()
 }
 
 /// How a lamp state reads in the table's colours.
@@ -214,8 +214,10 @@ mod tests {
             "last seen 10 s ago: {}",
             lines[1]
         );
-        let json: serde_json::Value = serde_json::from_str(&to_json(&rows)).unwrap();
-        assert_eq!(json[2]["power"], 150);
-        assert_eq!(json[0]["trouble"], true);
+        let Ok(Json::Array(json)) = json::parse(&to_json(&rows)) else {
+            panic!("not a JSON array: {}", to_json(&rows));
+        };
+        assert_eq!(json[2].get("power"), Some(&Json::Int(150)));
+        assert_eq!(json[0].get("trouble"), Some(&Json::Bool(true)));
     }
 }

@@ -5,6 +5,7 @@
 //! of its own: the Modem view renders every one from this.
 
 use plm_core::field::{Field, Kind};
+use plm_core::json::{self, Json};
 use plm_core::mib::Object;
 
 /// Texts by field name: what a form's inputs hold, or what is wrong with
@@ -222,38 +223,37 @@ pub const PROFILE_FORMAT: &str = "plm-console MIB profile";
 /// loaded from a JSON file (`{"format":…, "chip":"ST7580", "objects":
 /// {"01": "014ff0…"}}`, values as lowercase hex).
 pub fn profile_json(values: &MibValues) -> String {
-    let mut objects = serde_json::Map::new();
+    let mut objects = json::Object::new();
     for o in plm_core::mib::ST7580.iter().filter(|o| o.access.write) {
         if let Some(v) = values.get(&(o.index as u8)) {
             objects.insert(
                 format!("{:02x}", o.index),
-                serde_json::Value::String(plm_core::hex::encode(v)),
+                Json::String(plm_core::hex::encode(v)),
             );
         }
     }
-    let v = serde_json::json!({
-        "format": PROFILE_FORMAT,
-        "chip": "ST7580",
-        "objects": objects,
-    });
-    serde_json::to_string_pretty(&v).unwrap_or_default()
+    let mut profile = json::Object::new();
+    profile.insert("format", Json::from(PROFILE_FORMAT));
+    profile.insert("chip", Json::from("ST7580"));
+    profile.insert("objects", Json::Object(objects));
+    Json::Object(profile).pretty()
 }
 
 /// Reads a profile file; every value is checked as a MIB_WriteRequest
 /// would be, and the first problem refuses the whole file.
 pub fn parse_profile(text: &str) -> Result<Vec<(u8, Vec<u8>)>, String> {
-    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| format!("not JSON ({e})"))?;
-    if v.get("format").and_then(|f| f.as_str()) != Some(PROFILE_FORMAT) {
+    let v = json::parse(text).map_err(|e| format!("not JSON ({e})"))?;
+    if v.get("format").and_then(Json::as_str) != Some(PROFILE_FORMAT) {
         return Err(format!(
             "not a profile: \"format\" must be \"{PROFILE_FORMAT}\""
         ));
     }
-    if v.get("chip").and_then(|c| c.as_str()) != Some("ST7580") {
+    if v.get("chip").and_then(Json::as_str) != Some("ST7580") {
         return Err("the profile is not for the ST7580".to_string());
     }
     let objects = v
         .get("objects")
-        .and_then(|o| o.as_object())
+        .and_then(Json::as_object)
         .ok_or("the profile has no \"objects\"")?;
     let mut out = Vec::new();
     for (key, value) in objects {

@@ -8,8 +8,8 @@
 //! takes `plm decode` output as it is (elements without a time).
 
 use plm_core::decode::Decoded;
+use plm_core::json::{self, Json};
 use plm_core::time::Instant;
-use serde_json::{Map, Value as Json};
 use std::collections::VecDeque;
 
 /// Elements kept before the oldest are dropped.
@@ -52,16 +52,22 @@ impl Entry {
         }
     }
 
+    /// The object of the JSON Lines export: `time_us` (when known), then
+    /// what `plm decode` prints for the element.
+    pub fn to_json(&self) -> Json {
+        let mut o = json::Object::new();
+        if let Some(t) = self.at {
+            o.insert("time_us", Json::from(t));
+        }
+        if let Json::Object(members) = self.decoded.to_json() {
+            o.extend(members);
+        }
+        Json::Object(o)
+    }
+
     /// The line of the JSON Lines export.
     pub fn to_json_line(&self) -> String {
-        let mut map = Map::new();
-        if let Some(t) = self.at {
-            map.insert("time_us".into(), Json::from(t));
-        }
-        if let Ok(Json::Object(fields)) = serde_json::to_value(&self.decoded) {
-            map.extend(fields);
-        }
-        Json::Object(map).to_string()
+        self.to_json().to_string()
     }
 }
 
@@ -224,7 +230,7 @@ pub struct Imported {
 }
 
 fn parse_line(line: &str) -> Result<(Option<Instant>, Decoded), String> {
-    let v: Json = serde_json::from_str(line).map_err(|e| format!("not JSON ({e})"))?;
+    let v = json::parse(line).map_err(|e| format!("not JSON ({e})"))?;
     let Json::Object(mut map) = v else {
         return Err("not a JSON object".to_string());
     };
@@ -235,8 +241,7 @@ fn parse_line(line: &str) -> Result<(Option<Instant>, Decoded), String> {
                 .ok_or_else(|| "time_us is not a whole number of µs".to_string())?,
         ),
     };
-    let d: Decoded =
-        serde_json::from_value(Json::Object(map)).map_err(|e| format!("not an element ({e})"))?;
+    let d = Decoded::from_json(&Json::Object(map)).map_err(|e| format!("not an element ({e})"))?;
     plm_core::hex::parse(&d.hex).map_err(|e| format!("hex: {e}"))?;
     Ok((at, d))
 }
@@ -342,10 +347,24 @@ mod tests {
     }
 
     #[test]
+    fn an_unknown_command_stays_unknown_through_export_and_import() {
+        let mut log = TrafficLog::default();
+        for d in elements(Source::Modem, "02 00 7f 7f 00") {
+            log.push(Some(5), d);
+        }
+        let text = log.export();
+        assert!(text.contains(r#""command":null"#), "{text}");
+        let mut back = TrafficLog::default();
+        back.import(&text).unwrap();
+        assert_eq!(back.iter().next().unwrap().title(), "unknown command 7Fh");
+        assert_eq!(back.export(), text);
+    }
+
+    #[test]
     fn import_takes_plm_decode_output_and_reports_bad_lines() {
         let plain: Vec<String> = elements(Source::Any, "02 00 2c 2c 00 06")
             .iter()
-            .map(|d| serde_json::to_string(d).unwrap())
+            .map(|d| d.to_json().to_string())
             .collect();
         let text = format!("{}\nnot json\n\n{}\n[1]\n", plain[0], plain[1]);
         let mut log = TrafficLog::default();

@@ -14,52 +14,57 @@
 
 use crate::field::{Field, Value};
 use crate::hex;
+use crate::json::{json_record, Json, Object};
 use crate::link::{Dialect, Element, GarbageReason, Source, StreamDecoder};
 use crate::st7580::fields::{indication_data, reset_data, status, tx_options};
 use crate::st7580::{self, code as c, Command};
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
-use serde::{Deserialize, Serialize};
-use serde_json::{Map, Value as Json};
 
 /// One decoded element, ready to serialise as a JSON line.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Decoded {
     /// `frame`, `ack`, `nak`, `status` or `garbage`.
     pub kind: String,
     /// Who sent it, when known (`host` or `modem`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub from: Option<String>,
     /// The bytes as on the wire, lowercase hex.
     pub hex: String,
     /// STX byte (frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stx: Option<u8>,
     /// Length byte as sent (frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<u8>,
     /// Command code (frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub code: Option<u8>,
     /// The manual's command name; `null` for a code it does not define.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub command: Option<Json>,
     /// The checksum as received (frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub checksum: Option<u16>,
     /// Whether the checksum is right (frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub checksum_ok: Option<bool>,
     /// Named fields (frames, status messages).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fields: Option<Map<String, Json>>,
+    pub fields: Option<Object>,
     /// Why the data could not be decoded, or what the modem will refuse.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
     /// Why bytes are garbage: `unexpected` or `truncated`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
 }
+
+// The object `plm decode` prints, and the console exports and imports.
+json_record!(Decoded {
+    kind,
+    from,
+    hex,
+    stx,
+    length,
+    code,
+    command,
+    checksum,
+    checksum_ok,
+    fields,
+    error,
+    reason,
+});
 
 /// A field value as JSON: numbers as numbers, enums by the manual's name,
 /// bytes as lowercase hex, "no value" as null.
@@ -75,14 +80,14 @@ pub fn json_value(v: &Value) -> Json {
     }
 }
 
-pub(crate) fn put_layout(map: &mut Map<String, Json>, layout: &'static [Field], data: &[u8]) {
+pub(crate) fn put_layout(map: &mut Object, layout: &'static [Field], data: &[u8]) {
     for (f, v) in crate::mib::describe(layout, data) {
-        map.insert(f.name.to_string(), json_value(&v));
+        map.insert(f.name, json_value(&v));
     }
 }
 
-fn put_hex(map: &mut Map<String, Json>, key: &str, bytes: &[u8]) {
-    map.insert(key.to_string(), Json::String(hex::encode(bytes)));
+fn put_hex(map: &mut Object, key: &str, bytes: &[u8]) {
+    map.insert(key, Json::String(hex::encode(bytes)));
 }
 
 /// Decodes a host-interface stream into [`Decoded`] elements, keeping the
@@ -164,7 +169,7 @@ impl Decoder {
                 if self.dialect == Dialect::St7580 {
                     d.command =
                         Some(c::name(frame.code).map_or(Json::Null, |n| Json::String(n.into())));
-                    let mut fields = Map::new();
+                    let mut fields = Object::new();
                     match Command::parse(frame.code, &frame.data) {
                         Ok(cmd) => d.error = self.command_fields(&cmd, &frame.data, &mut fields),
                         Err(err) => {
@@ -174,13 +179,13 @@ impl Decoder {
                     }
                     d.fields = Some(fields);
                 } else {
-                    let mut fields = Map::new();
+                    let mut fields = Object::new();
                     put_hex(&mut fields, "data", &frame.data);
                     d.fields = Some(fields);
                 }
             }
             Element::Status(s) => {
-                let mut fields = Map::new();
+                let mut fields = Object::new();
                 if self.dialect == Dialect::St7580 {
                     put_layout(&mut fields, status::LAYOUT, s.data());
                 } else {
@@ -206,23 +211,18 @@ impl Decoder {
     /// would refuse about it, if anything.
     /// `data` is the frame's data field, from which the layouts read
     /// directly (nothing is re-encoded).
-    fn command_fields(
-        &mut self,
-        cmd: &Command,
-        data: &[u8],
-        f: &mut Map<String, Json>,
-    ) -> Option<String> {
+    fn command_fields(&mut self, cmd: &Command, data: &[u8], f: &mut Object) -> Option<String> {
         use Command::*;
         let mut problem = None;
         match cmd {
             BioResetRequest | MibWriteConfirm | MibEraseConfirm => {}
             BioResetConfirm { confirm_data } => {
-                f.insert("confirm_data".into(), Json::from(*confirm_data));
+                f.insert("confirm_data", Json::from(*confirm_data));
             }
             BioResetError(e) | MibWriteError(e) | MibReadError(e) | MibEraseError(e)
             | PhyDataError(e) | DlDataError(e) | SsDataError(e) => {
                 f.insert(
-                    "error_data".into(),
+                    "error_data",
                     e.name()
                         .map_or(Json::from(e.byte()), |n| Json::String(n.into())),
                 );
@@ -235,10 +235,10 @@ impl Decoder {
                 }
             }
             MibReadRequest { index } | MibEraseRequest { index } => {
-                f.insert("index".into(), Json::from(*index));
+                f.insert("index", Json::from(*index));
                 let name = st7580::mib::object(*index).map(|o| o.name);
                 f.insert(
-                    "object".into(),
+                    "object",
                     name.map_or(Json::Null, |n| Json::String(n.into())),
                 );
                 if matches!(cmd, MibReadRequest { .. }) {
@@ -261,10 +261,7 @@ impl Decoder {
             }
             SsDataRequest(r) => {
                 put_tx_params(f, data, &r.params);
-                f.insert(
-                    tx_options::HEADER_LENGTH.name.into(),
-                    Json::from(r.header_length),
-                );
+                f.insert(tx_options::HEADER_LENGTH.name, Json::from(r.header_length));
                 put_hex(f, "header_and_payload", &r.header_and_payload);
             }
             PhyDataConfirm(_) | DlDataConfirm(_) | SsDataConfirm(_) => {
@@ -289,7 +286,7 @@ impl Decoder {
                 }
             }
             CmdSyntaxError { error } => {
-                f.insert("error".into(), Json::from(*error));
+                f.insert("error", Json::from(*error));
             }
         }
         problem
@@ -298,14 +295,14 @@ impl Decoder {
 
 /// Index, object name and fields of a MIB value; a problem if the value
 /// does not fit the object.
-fn put_object(f: &mut Map<String, Json>, index: u8, data: &[u8]) -> Option<String> {
-    f.insert("index".into(), Json::from(index));
+fn put_object(f: &mut Object, index: u8, data: &[u8]) -> Option<String> {
+    f.insert("index", Json::from(index));
     let Some(o) = st7580::mib::object(index) else {
-        f.insert("object".into(), Json::Null);
+        f.insert("object", Json::Null);
         put_hex(f, "data", data);
         return Some(alloc::format!("there is no MIB object {index:02X}h"));
     };
-    f.insert("object".into(), Json::String(o.name.into()));
+    f.insert("object", Json::String(o.name.into()));
     put_hex(f, "data", data);
     if data.len() != o.len {
         return Some(alloc::format!(
@@ -323,22 +320,19 @@ fn put_object(f: &mut Map<String, Json>, index: u8, data: &[u8]) -> Option<Strin
 /// (`app::line`), under the key `app`, when the payload can be one. A
 /// sniffed frame's payload still ends with its wrong DL CRC, whose length
 /// the indication does not give: it shows as the last payload bytes.
-fn put_app(f: &mut Map<String, Json>, payload: &[u8]) {
+fn put_app(f: &mut Object, payload: &[u8]) {
     if let Some(line) = crate::app::LineFrame::parse(payload) {
-        f.insert(
-            "app".into(),
-            crate::decode_app::decode_line(&line).to_json(),
-        );
+        f.insert("app", crate::decode_app::decode_line(&line).to_json());
     }
 }
 
-fn put_tx_params(f: &mut Map<String, Json>, bytes: &[u8], p: &st7580::TxParams) {
+fn put_tx_params(f: &mut Object, bytes: &[u8], p: &st7580::TxParams) {
     put_layout(f, tx_options::LAYOUT, bytes);
     if let Some(hz) = p.tx_frequency {
-        f.insert(tx_options::TX_FREQUENCY.name.into(), Json::from(hz));
+        f.insert(tx_options::TX_FREQUENCY.name, Json::from(hz));
     }
     if let Some(g) = p.tx_gain {
-        f.insert(tx_options::TX_GAIN.name.into(), Json::from(g));
+        f.insert(tx_options::TX_GAIN.name, Json::from(g));
     }
 }
 

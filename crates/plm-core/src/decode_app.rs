@@ -23,63 +23,68 @@ use crate::app::service::{self, Service};
 use crate::app::{AppFrame, FrameType, LineFrame, Message, UsartDecoder, UsartElement};
 use crate::decode::put_layout;
 use crate::hex;
+use crate::json::{json_record, Json, Object};
 use crate::st7580;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
-use serde::{Deserialize, Serialize};
-use serde_json::{Map, Value as Json};
 
 /// One decoded application frame or run of garbage, ready to serialise as
 /// a JSON line.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AppDecoded {
     /// `frame` or `garbage`.
     pub kind: String,
     /// The bytes as on the wire (USART frame, or DL payload), lowercase hex.
     pub hex: String,
     /// Length byte as sent (USART frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<u8>,
     /// Frame type value, bits 0-6 of the type byte.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub code: Option<u8>,
     /// The seed's name of the frame type (`APP_SERVICE_FRAME`); `null` for
     /// a type it does not define.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frame_type: Option<Json>,
     /// BROADCAST_FLAG (4.6.1).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub broadcast: Option<bool>,
     /// The remote board (USART frames): target of a request, source of an
     /// answer; 12 lowercase hex digits.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub address: Option<String>,
     /// Who a line frame is for.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub destination: Option<String>,
     /// Who sent a line frame.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source: Option<String>,
     /// The seed's name of what the frame says (`SERVICE_PLM_CLOCK_GET`,
     /// `Lamp dimming`, `APP_PING_FRAME`); `null` for an unknown type.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub command: Option<Json>,
     /// `request` or `reply`, when the frame tells.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub direction: Option<String>,
     /// Named fields.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fields: Option<Map<String, Json>>,
+    pub fields: Option<Object>,
     /// The CRC-16 as received (USART frames, Appendix C).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crc: Option<u16>,
     /// Whether the CRC-16 is right.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crc_ok: Option<bool>,
     /// Why the payload does not fit its frame type, in words.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
 }
+
+// The object `plm decode --board` prints, and the `app` key of a DL frame.
+json_record!(AppDecoded {
+    kind,
+    hex,
+    length,
+    code,
+    frame_type,
+    broadcast,
+    address,
+    destination,
+    source,
+    command,
+    direction,
+    fields,
+    crc,
+    crc_ok,
+    error,
+});
 
 impl AppDecoded {
     fn new(kind: &str, bytes: &[u8]) -> Self {
@@ -102,19 +107,13 @@ impl AppDecoded {
         }
     }
 
-    /// The object as a JSON value (for embedding, e.g. the `app` key of a
-    /// DL frame).
-    pub fn to_json(&self) -> Json {
-        serde_json::to_value(self).unwrap_or(Json::Null)
-    }
-
     /// The same element in the modem decoder's shape, so that one traffic
     /// inspector (and its export) shows both: `from` is who sent it
     /// (`host` or `board`); the command is the frame's name, the checksum
     /// its CRC-16, and the address, frame type, broadcast flag and
     /// direction lead its fields.
     pub fn to_decoded(&self, from: &str) -> crate::decode::Decoded {
-        let mut fields = Map::new();
+        let mut fields = Object::new();
         let mut put = |k: &str, v: Option<Json>| {
             if let Some(v) = v {
                 fields.insert(k.to_string(), v);
@@ -151,7 +150,7 @@ impl AppDecoded {
         self.code = Some(frame_type.byte());
         self.frame_type = Some(name_or_null(frame_type.name()));
         self.broadcast = Some(broadcast);
-        let mut fields = Map::new();
+        let mut fields = Object::new();
         match Message::parse(frame_type, payload) {
             Ok(m) => {
                 self.command = Some(match m {
@@ -182,8 +181,8 @@ fn name_or_null(name: Option<&str>) -> Json {
     name.map_or(Json::Null, |n| Json::String(n.into()))
 }
 
-fn put_hex(map: &mut Map<String, Json>, key: &str, bytes: &[u8]) {
-    map.insert(key.into(), Json::String(hex::encode(bytes)));
+fn put_hex(map: &mut Object, key: &str, bytes: &[u8]) {
+    map.insert(key, Json::String(hex::encode(bytes)));
 }
 
 /// Whether a message is a request or a reply, when its bytes tell: a
@@ -205,7 +204,7 @@ fn direction(m: &Message) -> Option<&'static str> {
 
 /// Fills `f` with the named fields of `m` (read from `payload`, the bytes
 /// after the address); returns a problem with the value, if any.
-fn message_fields(m: &Message, payload: &[u8], f: &mut Map<String, Json>) -> Option<String> {
+fn message_fields(m: &Message, payload: &[u8], f: &mut Object) -> Option<String> {
     match m {
         Message::Service(s) => put_layout(f, s.layout(), payload.get(1..).unwrap_or(&[])),
         Message::Hid(h) => hid_fields(h, f),
@@ -214,14 +213,14 @@ fn message_fields(m: &Message, payload: &[u8], f: &mut Map<String, Json>) -> Opt
         Message::Ack { frame_type, echo } => {
             // 4.6.2, 4.6.4: buffer[8] the acknowledged frame type,
             // buffer[9] the command echo.
-            f.insert("frame_type".into(), frame_type_json(*frame_type));
-            f.insert("command_echo".into(), Json::from(*echo));
+            f.insert("frame_type", frame_type_json(*frame_type));
+            f.insert("command_echo", Json::from(*echo));
         }
         Message::Error(code) => {
             // 4.6.3: user_error_code = buffer[8] << 8 | buffer[9].
-            f.insert("error_code".into(), Json::from(code.0));
-            f.insert("error_name".into(), name_or_null(code.name()));
-            f.insert("meaning".into(), Json::String(code.to_string()));
+            f.insert("error_code", Json::from(code.0));
+            f.insert("error_name", name_or_null(code.name()));
+            f.insert("meaning", Json::String(code.to_string()));
         }
         Message::Programming { group, data } => {
             put_layout(f, &[service::fields::GROUP], &[*group]);
@@ -230,9 +229,9 @@ fn message_fields(m: &Message, payload: &[u8], f: &mut Map<String, Json>) -> Opt
         Message::Mib { index, data } => {
             // The board's modem MIB object (UM0932 4), read when `data` is
             // empty (protocol notes).
-            f.insert("index".into(), Json::from(*index));
+            f.insert("index", Json::from(*index));
             let object = st7580::mib::object(*index);
-            f.insert("object".into(), name_or_null(object.map(|o| o.name)));
+            f.insert("object", name_or_null(object.map(|o| o.name)));
             if !data.is_empty() {
                 put_hex(f, "data", data);
                 match object {
@@ -261,7 +260,7 @@ fn frame_type_json(t: FrameType) -> Json {
 }
 
 /// HID fields (Appendix A), named after the seed.
-fn hid_fields(h: &Hid, f: &mut Map<String, Json>) {
+fn hid_fields(h: &Hid, f: &mut Object) {
     let param_name = |p: u8| hid::param(p).map_or(Json::from(p), |d| Json::String(d.name.into()));
     match h {
         Hid::Reset(t) => {
@@ -270,16 +269,16 @@ fn hid_fields(h: &Hid, f: &mut Map<String, Json>) {
                 hid::RESET_HARDWARE => Json::String("Hardware reset".into()),
                 other => Json::from(other),
             };
-            f.insert("reset_type".into(), name);
+            f.insert("reset_type", name);
         }
         Hid::Dimming(v) => {
-            f.insert("dimming_value".into(), Json::from(*v));
+            f.insert("dimming_value", Json::from(*v));
         }
         Hid::Get(p) => {
-            f.insert("param_to_get".into(), param_name(*p));
+            f.insert("param_to_get", param_name(*p));
         }
         Hid::Reply { param, value } => {
-            f.insert("param_to_get".into(), param_name(*param));
+            f.insert("param_to_get", param_name(*param));
             if let Some(d) = hid::param(*param) {
                 put_layout(f, d.fields, value);
             }
@@ -354,9 +353,9 @@ mod tests {
         assert_eq!(d.address.as_deref(), Some("0080e100002a"));
         assert_eq!(d.crc_ok, Some(true));
         let f = d.fields.unwrap();
-        assert_eq!(f["hours"], 12);
-        assert_eq!(f["minutes"], 30);
-        assert_eq!(f["seconds"], 5);
+        assert_eq!(f.get("hours"), Some(&Json::from(12)));
+        assert_eq!(f.get("minutes"), Some(&Json::from(30)));
+        assert_eq!(f.get("seconds"), Some(&Json::from(5)));
     }
 
     #[test]
@@ -364,11 +363,18 @@ mod tests {
         let d = one(&Message::Error(ErrorCode::HID_TIMEOUT));
         assert_eq!(d.direction.as_deref(), Some("reply"));
         let f = d.fields.unwrap();
-        assert_eq!(f["error_code"], 0x12);
-        assert_eq!(f["error_name"], "HID board response timeout");
-        assert!(f["meaning"].as_str().unwrap().contains("ballast"));
+        assert_eq!(f.get("error_code"), Some(&Json::from(0x12)));
+        assert_eq!(
+            f.get("error_name"),
+            Some(&Json::from("HID board response timeout"))
+        );
+        assert!(f
+            .get("meaning")
+            .and_then(Json::as_str)
+            .unwrap()
+            .contains("ballast"));
         let d = one(&Message::Error(ErrorCode(0x4242)));
-        assert_eq!(d.fields.unwrap()["error_name"], Json::Null);
+        assert_eq!(d.fields.unwrap().get("error_name"), Some(&Json::Null));
     }
 
     #[test]
@@ -376,7 +382,7 @@ mod tests {
         let frame = AppFrame::new(FrameType::Service, A, alloc::vec![0x08, 1]);
         let d = decode_usart(&frame.emit().unwrap()).remove(0);
         assert_eq!(d.command, Some(Json::from("SERVICE_PLM_CLOCK_GET")));
-        assert_eq!(d.fields.unwrap()["payload"], "0801");
+        assert_eq!(d.fields.unwrap().get("payload"), Some(&Json::from("0801")));
         assert!(d.error.unwrap().contains("SERVICE_PLM_CLOCK_GET"));
         assert_eq!(d.direction, None);
     }
@@ -388,7 +394,7 @@ mod tests {
         assert_eq!(d.frame_type, Some(Json::Null));
         assert_eq!(d.command, Some(Json::Null));
         assert_eq!(d.code, Some(0x33));
-        assert_eq!(d.fields.unwrap()["payload"], "0102");
+        assert_eq!(d.fields.unwrap().get("payload"), Some(&Json::from("0102")));
     }
 
     #[test]
@@ -402,7 +408,10 @@ mod tests {
         assert_eq!(d.crc, None);
         assert_eq!(d.length, None);
         assert_eq!(d.command, Some(Json::from("Get HID parameter")));
-        assert_eq!(d.fields.unwrap()["param_to_get"], "GET ALL PARAMETERS");
+        assert_eq!(
+            d.fields.unwrap().get("param_to_get"),
+            Some(&Json::from("GET ALL PARAMETERS"))
+        );
         assert_eq!(d.hex, hex::encode(&line.emit()));
     }
 
@@ -427,10 +436,10 @@ mod tests {
             .unwrap()
         };
         let d = crate::decode::decode_all(Dialect::St7580, Source::Modem, &ind(line.emit()));
-        let app = &d[0].fields.as_ref().unwrap()["app"];
-        assert_eq!(app["command"], "APP_PING_FRAME");
-        assert_eq!(app["source"], "000000000007");
-        assert_eq!(app["destination"], "0080e100002a");
+        let app = d[0].fields.as_ref().unwrap().get("app").unwrap();
+        assert_eq!(app.get("command"), Some(&Json::from("APP_PING_FRAME")));
+        assert_eq!(app.get("source"), Some(&Json::from("000000000007")));
+        assert_eq!(app.get("destination"), Some(&Json::from("0080e100002a")));
         // Too short to be a line frame: no `app` key.
         let d = crate::decode::decode_all(Dialect::St7580, Source::Modem, &ind(alloc::vec![1, 2]));
         assert!(d[0].fields.as_ref().unwrap().get("app").is_none());

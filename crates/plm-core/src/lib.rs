@@ -16,6 +16,12 @@
 //!   prints and the console's traffic inspector shows.
 //! - [`decode_app`]: the same view of the controller board's application
 //!   frames, on its USART and on the power line.
+//! - [`json`]: the JSON values, writer and parser those views and the
+//!   console's files use (byte for byte what serde_json writes).
+//!
+//! Feature `serde` (default): `Serialize` for the decoded views, for
+//! native tools that write with serde_json. The console turns it off:
+//! its size budget has no room for serde's code.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -29,6 +35,7 @@ pub mod decode;
 pub mod decode_app;
 pub mod field;
 pub mod hex;
+pub mod json;
 pub mod link;
 pub mod mib;
 pub mod st7580;

@@ -9,6 +9,7 @@ use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;
 use leptos::prelude::*;
+use plm_core::json::Json;
 use plm_core::st7580::fields::{confirm_data, tx_options, MODULATIONS};
 use plm_core::st7580::mib::{index, ModemConfig};
 use plm_core::st7580::{
@@ -33,8 +34,8 @@ fn field(e: &Entry, name: &str) -> String {
         .as_ref()
         .and_then(|f| f.get(name))
         .map(|v| match v {
-            serde_json::Value::String(s) => s.clone(),
-            serde_json::Value::Null => "–".into(),
+            Json::String(s) => s.clone(),
+            Json::Null => "–".into(),
             v => v.to_string(),
         })
         .unwrap_or_default()

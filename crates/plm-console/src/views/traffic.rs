@@ -265,11 +265,7 @@ fn Details(selected: RwSignal<Option<u64>>) -> impl IntoView {
     let c = use_console();
     let json = move || {
         let seq = selected.get()?;
-        c.traffic.log.with(|l| {
-            let e = l.get(seq)?;
-            let v: serde_json::Value = serde_json::from_str(&e.to_json_line()).ok()?;
-            serde_json::to_string_pretty(&v).ok()
-        })
+        c.traffic.log.with(|l| Some(l.get(seq)?.to_json().pretty()))
     };
     view! {
         <aside class="details" id="traffic-details">

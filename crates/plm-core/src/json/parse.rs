@@ -8,8 +8,8 @@ use alloc::vec::Vec;
 use core::fmt;
 
 /// Arrays and objects nested deeper than this are refused rather than
-/// risking the stack (serde_json's limit too).
-const MAX_DEPTH: usize = 128;
+/// risking the stack; serde_json refuses the 128th level too.
+const MAX_DEPTH: usize = 127;
 
 /// Where a text stops being JSON, and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -20,8 +20,8 @@ pub struct ParseError {
     pub column: usize,
     /// What would have been JSON there (`a value`, `` `,` or `]` ``).
     pub expected: &'static str,
-    /// What is there instead: a character in backquotes, or `the end of
-    /// the text`.
+    /// What is there instead: a character in backquotes, a control
+    /// character by its code point (`U+0009`), or `the end of the text`.
     pub found: String,
 }
 
@@ -62,7 +62,7 @@ impl Parser<'_> {
         let line = before.matches('\n').count() + 1;
         let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
         let found = match self.text[self.pos..].chars().next() {
-            Some(c) if c.is_control() => alloc::format!("{c:?}"),
+            Some(c) if c.is_control() => alloc::format!("U+{:04X}", u32::from(c)),
             Some(c) => alloc::format!("`{c}`"),
             None => "the end of the text".into(),
         };
@@ -99,7 +99,7 @@ impl Parser<'_> {
             Some(b'"') => Ok(Json::String(self.string()?)),
             Some(b'-' | b'0'..=b'9') => self.number(),
             Some(b'[' | b'{') if depth == MAX_DEPTH => {
-                Err(self.error("at most 128 nested arrays and objects"))
+                Err(self.error("at most 127 nested arrays and objects"))
             }
             Some(b'[') => self.array(depth + 1),
             Some(b'{') => self.object(depth + 1),
