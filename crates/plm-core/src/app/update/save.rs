@@ -211,7 +211,6 @@ mod tests {
     use super::*;
     use crate::app::message::Message;
     use crate::app::service::Release;
-    use alloc::vec;
 
     #[test]
     fn a_campaign_saved_mid_way_resumes_where_it_was() {
@@ -249,7 +248,7 @@ mod tests {
             .unwrap_err()
             .contains("not the one"));
         assert!(Update::resume(image.clone(), &saved[..saved.len() - 1], 0).is_err());
-        assert!(Update::resume(image, &vec![0; 40], 0)
+        assert!(Update::resume(image, &[0; 40], 0)
             .unwrap_err()
             .contains("not a saved"));
     }
