@@ -4,10 +4,12 @@
 
 mod harness;
 
-use harness::{ping_responder, ByteCtx, Dir, Fault, Part, Sim, PING_CNF, PING_REQ};
+use harness::{faults, ping_responder, Dir, Fault, Part, Sim, PING_CNF, PING_REQ};
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Transmit};
-use plm_core::link::{Dialect, Element, GarbageReason, LocalFrame, Stx, Timeouts, ACK};
+use plm_core::link::{
+    Dialect, Element, GarbageReason, LocalFrame, Stx, TicSelector, Timeouts, ACK,
+};
 use plm_core::time::{wire_time, Instant, MS};
 use proptest::prelude::*;
 
@@ -921,8 +923,19 @@ enum Op {
     Submit(u8, Vec<u8>),
     /// Device only: T_REQ changes.
     TReq(bool),
-    /// Change the timeouts.
-    Timeouts(u8, u8, u8),
+    /// Change the timeouts: T_SR, T_ACK, T_IC, T_POLL (ms), T_WBC (ms,
+    /// may be 0).
+    Timeouts(u8, u8, u8, u8, u8),
+    /// Device only: MIB 000Bh's T_IC selector (ST7570; b7 set or not).
+    Tic(bool),
+}
+
+fn timeouts(a: u8, b: u8, c: u8, poll: u8, wbc: u8) -> Timeouts {
+    Timeouts {
+        t_poll: poll as u64 * MS,
+        t_wbc: wbc as u64 * MS,
+        ..Timeouts::from_ms(a, b, c)
+    }
 }
 
 fn op() -> impl Strategy<Value = Op> {
@@ -932,7 +945,9 @@ fn op() -> impl Strategy<Value = Op> {
         3 => Just(Op::Deadline),
         1 => (any::<u8>(), prop::collection::vec(any::<u8>(), 0..300)).prop_map(|(c, d)| Op::Submit(c, d)),
         2 => any::<bool>().prop_map(Op::TReq),
-        1 => (1u8..=255, 1u8..=255, 1u8..=255).prop_map(|(a, b, c)| Op::Timeouts(a, b, c)),
+        1 => (1u8..=255, 1u8..=255, 1u8..=255, 1u8..=255, 0u8..=255)
+            .prop_map(|(a, b, c, p, w)| Op::Timeouts(a, b, c, p, w)),
+        1 => any::<bool>().prop_map(Op::Tic),
     ]
 }
 
@@ -956,7 +971,7 @@ proptest! {
 
     #[test]
     fn host_engine_survives_any_input(d in dialect(), baud in prop_oneof![Just(9_600u32), Just(57_600)], ops in prop::collection::vec(op(), 0..60)) {
-        let mut host = HostEngine::new(d, HostConfig { baud, ..HostConfig::default() });
+        let mut host = HostEngine::new(d, HostConfig::at_reset(d, baud));
         let mut now: Instant = 0;
         let mut tickets = Vec::new();
         let mut ends = std::collections::HashMap::new();
@@ -979,8 +994,8 @@ proptest! {
                     }
                 }
                 Op::Submit(c, data) => tickets.push(host.submit(now, LocalFrame::new(c, data))),
-                Op::TReq(_) => {}
-                Op::Timeouts(a, b, c) => host.set_config(HostConfig { timeouts: Timeouts::from_ms(a, b, c), ..host.config() }),
+                Op::TReq(_) | Op::Tic(_) => {}
+                Op::Timeouts(a, b, c, p, w) => host.set_config(HostConfig { timeouts: timeouts(a, b, c, p, w), ..host.config() }),
             }
             while host.poll_transmit().is_some() {}
             while let Some(e) = host.poll_event() {
@@ -1031,7 +1046,8 @@ proptest! {
                 }
                 Op::Submit(c, data) => dev.submit(now, LocalFrame::new(c, data)),
                 Op::TReq(a) => dev.set_treq(now, a),
-                Op::Timeouts(a, b, c) => dev.set_timeouts(Timeouts::from_ms(a, b, c)),
+                Op::Timeouts(a, b, c, p, w) => dev.set_timeouts(timeouts(a, b, c, p, w)),
+                Op::Tic(ten_ms) => dev.set_tic(if ten_ms { TicSelector::TenMs } else { TicSelector::FiveCharacters }),
             }
             while dev.poll_transmit().is_some() {}
             while dev.poll_event().is_some() {}
@@ -1047,52 +1063,6 @@ proptest! {
         }
         prop_assert_eq!(dev.poll_timeout(), None);
         prop_assert!(dev.is_idle());
-    }
-}
-
-/// A small deterministic generator for the fault injector.
-struct XorShift(u64);
-
-impl XorShift {
-    fn next(&mut self) -> u64 {
-        let mut x = self.0;
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        self.0 = x;
-        x
-    }
-}
-
-/// Random faults: per byte, `drop_pm`/1000 of a loss or (half as often)
-/// a stall of up to 30 ms, `corrupt_pm`/1000 of a damaged byte; at most
-/// one fault per frame transmission. The limit is the checksum's, not the
-/// engines': UM0932's checksum is a 16-bit sum, which two compensating
-/// errors in one frame pass (see
-/// `additive_checksum_misses_compensating_errors`), while it always sees a
-/// single changed byte.
-fn faults(seed: u64, drop_pm: u64, corrupt_pm: u64) -> impl FnMut(&ByteCtx) -> Option<Fault> {
-    let mut rng = XorShift(seed | 1);
-    let mut faulted_frame = None;
-    move |c| {
-        let r = rng.next() % 1000;
-        if let Part::Frame { n, .. } = c.part {
-            if faulted_frame == Some(n) {
-                return None;
-            }
-            if r < drop_pm + corrupt_pm {
-                faulted_frame = Some(n);
-            }
-        }
-        if r < drop_pm / 2 {
-            Some(Fault::Delay(rng.next() % (30 * MS)))
-        } else if r < drop_pm {
-            Some(Fault::Drop)
-        } else if r < drop_pm + corrupt_pm {
-            Some(Fault::Corrupt((rng.next() % 255 + 1) as u8))
-        } else {
-            None
-        }
     }
 }
 

@@ -1,19 +1,24 @@
 //! The device-side link engine: the modem's half of the host interface,
 //! used by the simulated modems. Sans-IO like [`super::host`].
 //!
-//! Rules implemented (ST7580, UM0932 3.2.5-3.2.9):
-//! - on T_REQ low, answer with the status message as soon as not busy
-//!   (3.2.8); accept the host's frame only if its STX comes within T_SR;
-//! - ACK a frame with right length and checksum, NAK any other (3.2.8);
-//! - send frames with STX 02h unprompted (the modem is master, 3.2.5);
-//!   on NAK, any other frame or no ACK within T_ACK, repeat once with
-//!   STX 03h T_ACK after the frame, and count the repeat as delivered
-//!   whatever the answer (3.2.7);
-//! - drop a frame whose characters are more than T_IC apart (3.2.6).
+//! Rules implemented (UM0932 3.2.5-3.2.9; ST7570 UM 5.2.2-5.2.3, where
+//! the chips differ the [`Dialect`] says how):
+//! - on T_REQ low, answer with the status message as soon as not busy;
+//!   accept the host's frame only if its STX comes within T_SR;
+//! - ACK a frame with right length and checksum, NAK any other;
+//! - send frames with STX 02h unprompted (the modem is master);
+//! - repeat a frame once as [`Dialect::modem_reaction`] says (ST7580: on
+//!   NAK, any other frame or no ACK within T_ACK, with STX 03h T_ACK after
+//!   the frame; ST7570: only on NAK, with STX 02h T_WBC after the NAK, a
+//!   missed or garbled ACK counting as ACK), and count the repeat as
+//!   delivered whatever the answer;
+//! - drop a frame whose characters are more than T_IC apart (ST7570: T_IC
+//!   as MIB 000Bh selects it, [`DeviceEngine::set_tic`]).
 
+use super::dialect::{Answer, Reaction};
 use super::host::Transmit;
 use super::rx::Receiver;
-use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
+use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, TicSelector, Timeouts};
 use crate::time::{earliest, Instant, TxClock};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
@@ -27,8 +32,9 @@ pub enum DeviceEvent {
     Sent(Element),
     /// A host frame was accepted and acknowledged: a request to execute.
     Request(LocalFrame),
-    /// A frame the device sent was acknowledged (`repeated`: only after
-    /// its STX 03h repeat, which counts as acknowledged by rule).
+    /// A frame the device sent was acknowledged, or counted as such by the
+    /// dialect's rule (`repeated`: only after its repeat, which counts as
+    /// acknowledged by rule).
     Delivered {
         /// The frame.
         frame: LocalFrame,
@@ -45,11 +51,16 @@ enum State {
         deadline: Instant,
     },
     /// A frame is out (STX 02h), its last byte leaving the UART at `end`:
-    /// waiting for ACK until `deadline`, then the repeat.
+    /// waiting for the host's answer until `deadline` (T_ACK).
     AwaitAck {
         frame: LocalFrame,
         end: Instant,
         deadline: Instant,
+    },
+    /// The frame will be repeated at `at` (ST7570: T_WBC after the NAK).
+    AwaitRepeat {
+        frame: LocalFrame,
+        at: Instant,
     },
 }
 
@@ -58,6 +69,9 @@ enum State {
 pub struct DeviceEngine {
     dialect: Dialect,
     timeouts: Timeouts,
+    /// ST7570: T_IC as MIB 000Bh selects it, kept to follow a baud change;
+    /// `None` when T_IC was given as a duration.
+    tic: Option<TicSelector>,
     baud: u32,
     state: State,
     rx: Receiver,
@@ -79,11 +93,13 @@ pub struct DeviceEngine {
 }
 
 impl DeviceEngine {
-    /// A device engine for `dialect` at `baud`, with the reset timeouts.
+    /// A device engine for `dialect` at `baud`, with the reset timeouts
+    /// ([`Timeouts::at_reset`]).
     pub fn new(dialect: Dialect, baud: u32) -> Self {
         DeviceEngine {
             dialect,
-            timeouts: Timeouts::default(),
+            timeouts: Timeouts::at_reset(dialect, baud),
+            tic: Self::reset_tic(dialect),
             baud,
             state: State::Idle,
             rx: Receiver::new(dialect, Source::Host),
@@ -103,14 +119,29 @@ impl DeviceEngine {
         self.timeouts
     }
 
-    /// Applies new timeouts (a MIB 09h write).
+    /// Applies new timeouts (ST7580: a MIB 09h write), T_IC as given.
     pub fn set_timeouts(&mut self, timeouts: Timeouts) {
         self.timeouts = timeouts;
+        self.tic = None;
     }
 
-    /// Changes the UART baud rate (the BR0/BR1 pins, read at reset).
+    /// ST7570: applies the T_IC selector of a MIB 000Bh write.
+    pub fn set_tic(&mut self, tic: TicSelector) {
+        self.tic = Some(tic);
+        self.timeouts = self.timeouts.with_tic(tic, self.baud);
+    }
+
+    fn reset_tic(dialect: Dialect) -> Option<TicSelector> {
+        (dialect == Dialect::St7570).then_some(TicSelector::FACTORY_DEFAULT)
+    }
+
+    /// Changes the UART baud rate (the BR0/BR1 pins, read at reset); a T_IC
+    /// of 5 characters follows it.
     pub fn set_baud(&mut self, baud: u32) {
         self.baud = baud;
+        if let Some(tic) = self.tic {
+            self.timeouts = self.timeouts.with_tic(tic, baud);
+        }
     }
 
     /// The bits the next status messages carry.
@@ -128,7 +159,8 @@ impl DeviceEngine {
         self.state = State::Idle;
         self.queue.clear();
         self.rx = Receiver::new(self.dialect, Source::Host);
-        self.timeouts = Timeouts::default();
+        self.timeouts = Timeouts::at_reset(self.dialect, self.baud);
+        self.tic = Self::reset_tic(self.dialect);
         self.treq_served = self.treq;
         self.host_frame_open = false;
     }
@@ -148,6 +180,12 @@ impl DeviceEngine {
     pub fn set_treq(&mut self, now: Instant, asserted: bool) {
         if asserted && !self.treq {
             self.treq_served = false;
+            // A new falling edge while the last status message's T_SR runs:
+            // the host missed that status and asks again; answer it (the
+            // ST7570 within T_POLL, UM 5.2.2).
+            if let State::AwaitHostFrame { .. } = self.state {
+                self.state = State::Idle;
+            }
         }
         self.treq = asserted;
         self.advance(now);
@@ -184,9 +222,10 @@ impl DeviceEngine {
         }
         match &self.state {
             State::AwaitHostFrame { deadline } if now > *deadline => self.state = State::Idle,
-            State::AwaitAck {
-                frame, deadline, ..
-            } if now >= *deadline => {
+            State::AwaitAck { deadline, .. } if now >= *deadline => {
+                self.on_answer(now, Answer::Silence)
+            }
+            State::AwaitRepeat { frame, at } if now >= *at => {
                 let frame = frame.clone();
                 self.repeat(now, frame);
             }
@@ -211,6 +250,7 @@ impl DeviceEngine {
             State::Idle => None,
             State::AwaitHostFrame { deadline } => Some(*deadline + 1),
             State::AwaitAck { deadline, .. } => Some(*deadline),
+            State::AwaitRepeat { at, .. } => Some(*at),
         };
         let rx = self.rx.deadline(self.timeouts.t_ic);
         earliest(state, rx)
@@ -242,18 +282,13 @@ impl DeviceEngine {
         end
     }
 
-    /// UM0932 3.2.7: repeat once with STX 03h; that one counts as delivered.
+    /// Repeats `frame` once with the dialect's STX (UM0932 3.2.7: 03h;
+    /// ST7570 UM 5.2.2: 02h); the repeat counts as delivered.
     fn repeat(&mut self, now: Instant, frame: LocalFrame) {
-        // STX 03h exists only in the ST7580 dialect; emitting it in the
-        // ST7570 one fails (and used to panic here). The ST7570 repeats with
-        // the same frame (its UM 5.2.2, after T_WBC and only on NAK: not
-        // modelled, only the ST7580 rules are).
-        let stx = if self.dialect.is_stx(Stx::Repeat.byte()) {
-            Stx::Repeat
-        } else {
-            Stx::First
+        let again = LocalFrame {
+            stx: self.dialect.repeat_stx(),
+            ..frame
         };
-        let again = LocalFrame { stx, ..frame };
         self.send_frame(now, &again);
         self.state = State::Idle;
         self.events.push_back(DeviceEvent::Delivered {
@@ -265,23 +300,48 @@ impl DeviceEngine {
         });
     }
 
-    fn on_element(&mut self, now: Instant, e: Element) {
-        self.events.push_back(DeviceEvent::Received(e.clone()));
-        match (&self.state, e) {
-            // Only an ACK that comes after the frame's last byte can be the
-            // host's answer to it (UM0932 3.2.3, 3.2.7): an earlier one
-            // answers what was sent before, typically the STX 03h repeat
-            // of the previous frame, written right before this one.
-            (State::AwaitAck { frame, end, .. }, Element::Ack) if now > *end => {
-                let frame = frame.clone();
+    /// The host answered the frame in flight (or did not, `Silence`).
+    fn on_answer(&mut self, now: Instant, answer: Answer) {
+        let State::AwaitAck { frame, .. } = &self.state else {
+            return;
+        };
+        let frame = frame.clone();
+        match self.dialect.modem_reaction(answer, &self.timeouts) {
+            Reaction::Delivered => {
                 self.state = State::Idle;
                 self.events.push_back(DeviceEvent::Delivered {
                     frame,
                     repeated: false,
                 });
             }
-            // NAK or another frame: the repeat still waits for T_ACK (3.2.7).
-            (State::AwaitAck { .. }, _) => {}
+            Reaction::Wait => {}
+            Reaction::Repeat { after: 0 } => self.repeat(now, frame),
+            Reaction::Repeat { after } => {
+                self.state = State::AwaitRepeat {
+                    frame,
+                    at: now + after,
+                }
+            }
+        }
+    }
+
+    fn on_element(&mut self, now: Instant, e: Element) {
+        self.events.push_back(DeviceEvent::Received(e.clone()));
+        match (&self.state, e) {
+            // Only what comes after the frame's last byte can be the host's
+            // answer to it (UM0932 3.2.3, 3.2.7): an earlier ACK or NAK
+            // answers what was sent before, typically the repeat of the
+            // previous frame, written right before this one.
+            (State::AwaitAck { end, .. }, e) if now > *end => {
+                let answer = match e {
+                    Element::Ack => Answer::Ack,
+                    Element::Nak => Answer::Nak,
+                    _ => Answer::Other,
+                };
+                self.on_answer(now, answer);
+            }
+            // Nothing the host sends changes a repeat already decided.
+            (State::AwaitAck { .. } | State::AwaitRepeat { .. }, _) => {}
             // A frame nobody asked for with T_REQ is ignored (3.2.8).
             (_, Element::Frame { .. }) if !self.host_frame_open => {}
             (

@@ -2,22 +2,25 @@
 //! quinn-proto: no port, no clock. The driver feeds bytes and time in and
 //! takes bytes, T_REQ levels and events out.
 //!
-//! Rules implemented (ST7580, UM0932 3.2.5-3.2.9):
-//! - to send, pull T_REQ low and wait for the status message (3.2.8);
-//! - send the frame with STX 02h, release T_REQ once STX is out (3.2.8);
+//! Rules implemented (UM0932 3.2.5-3.2.9; ST7570 UM 5.2.2-5.2.3, where
+//! the chips differ the [`Dialect`] says how):
+//! - to send, pull T_REQ low and wait for the status message (ST7580:
+//!   T_SR, 3.2.8; ST7570: T_POLL, 5.2.2);
+//! - send the frame with STX 02h, release T_REQ once STX is out;
 //! - expect ACK within T_ACK of the frame's last byte; on NAK or silence
-//!   restart the whole sequence (3.2.8), at most `max_attempts` times;
+//!   restart the whole sequence, at most `max_attempts` times;
 //! - ACK every modem frame with a right length and checksum, NAK the
-//!   others (3.2.7); a frame with STX 03h that repeats the frame just
-//!   accepted is acknowledged but not reported again (3.2.7);
-//! - drop a frame whose characters are more than T_IC apart (3.2.6).
+//!   others; the modem's repeat of a frame just accepted (ST7580: STX 03h;
+//!   ST7570: the same frame T_WBC after the ACK, which it took for a NAK)
+//!   is acknowledged but not reported again;
+//! - drop a frame whose characters are more than T_IC apart.
 //!
-//! Decisions where UM0932 is silent are in docs/protocol-notes.md
-//! ("Host link engine").
+//! Decisions where the seeds are silent are in docs/protocol-notes.md
+//! ("Host link engine", "ST7570: link").
 
 use super::rx::Receiver;
 use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
-use crate::time::{earliest, wire_time, Duration, Instant, TxClock};
+use crate::time::{earliest, Instant, TxClock};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
@@ -70,8 +73,9 @@ pub enum Event {
     Sent(Element),
     /// A modem frame was accepted and acknowledged.
     Frame(LocalFrame),
-    /// The modem repeated (STX 03h) a frame already accepted; it was
-    /// acknowledged and is not reported again as [`Event::Frame`].
+    /// The modem repeated a frame already accepted (see
+    /// [`Dialect::repeat_window`]); it was acknowledged and is not reported
+    /// again as [`Event::Frame`].
     Repeat(LocalFrame),
     /// The modem acknowledged a submitted frame.
     Delivered(Ticket),
@@ -100,11 +104,24 @@ pub struct HostConfig {
 }
 
 impl Default for HostConfig {
+    /// The ST7580's reset timeouts at 57 600 baud, three attempts.
     fn default() -> Self {
         HostConfig {
             timeouts: Timeouts::default(),
             baud: 57_600,
             max_attempts: 3,
+        }
+    }
+}
+
+impl HostConfig {
+    /// The settings for a chip of `dialect` just reset, its UART at `baud`
+    /// ([`Timeouts::at_reset`]), three attempts.
+    pub fn at_reset(dialect: Dialect, baud: u32) -> Self {
+        HostConfig {
+            timeouts: Timeouts::at_reset(dialect, baud),
+            baud,
+            ..HostConfig::default()
         }
     }
 }
@@ -117,6 +134,16 @@ enum State {
     AwaitStatus { deadline: Instant },
     /// The frame is out, waiting for ACK/NAK.
     AwaitAck { deadline: Instant },
+}
+
+/// A modem frame accepted (and ACKed) that the modem may still repeat.
+#[derive(Debug, Clone)]
+struct Accepted {
+    frame: LocalFrame,
+    /// When its last byte arrived.
+    end: Instant,
+    /// When the host's ACK had left the UART.
+    answered: Instant,
 }
 
 #[derive(Debug, Clone)]
@@ -139,9 +166,9 @@ pub struct HostEngine {
     next_ticket: u32,
     transmits: VecDeque<Transmit>,
     events: VecDeque<Event>,
-    /// The last frame accepted with STX 02h and when, to recognise its
-    /// repeat (UM0932 3.2.7).
-    last_accepted: Option<(LocalFrame, Instant)>,
+    /// The last frame accepted that the modem may repeat, to recognise
+    /// the repeat (UM0932 3.2.7, ST7570 UM 5.2.2).
+    last_accepted: Option<Accepted>,
     last_status: Option<StatusMessage>,
     /// When the UART will have sent every byte written so far: T_ACK runs
     /// from the frame's last byte on the wire (UM0932 3.2.8), which is later
@@ -150,7 +177,7 @@ pub struct HostEngine {
 }
 
 impl HostEngine {
-    /// A host engine for `dialect`. Only the ST7580 rules are implemented.
+    /// A host engine for `dialect`.
     pub fn new(dialect: Dialect, config: HostConfig) -> Self {
         HostEngine {
             dialect,
@@ -227,12 +254,15 @@ impl HostEngine {
             self.rx.push(now, b, self.config.timeouts.t_ic, &mut out);
             // Any modem activity while waiting for the status message means
             // the modem is busy with its own frame: keep waiting.
+            let wait = self.dialect.status_wait(&self.config.timeouts);
             if let State::AwaitStatus { deadline } = &mut self.state {
-                *deadline = (*deadline).max(now + self.config.timeouts.t_sr);
+                *deadline = (*deadline).max(now + wait);
             }
-        }
-        for e in out {
-            self.on_element(now, e);
+            // Each element as its last byte completes it: a repeat is told
+            // from a new frame by when its first byte came.
+            for e in out.drain(..) {
+                self.on_element(now, e);
+            }
         }
         self.advance(now);
     }
@@ -286,11 +316,13 @@ impl HostEngine {
         self.tx_clock.written(now, n, self.config.baud)
     }
 
-    fn send(&mut self, now: Instant, e: Element) {
+    /// Sends `e`; returns when its last byte will have left.
+    fn send(&mut self, now: Instant, e: Element) -> Instant {
         let bytes = e.to_bytes(self.dialect);
-        self.written(now, bytes.len());
+        let end = self.written(now, bytes.len());
         self.transmits.push_back(Transmit::Bytes(bytes));
         self.events.push_back(Event::Sent(e));
+        end
     }
 
     fn on_element(&mut self, now: Instant, e: Element) {
@@ -305,17 +337,31 @@ impl HostEngine {
                     return;
                 }
                 // The ACK is sent at once, well within T_ACK.
-                self.send(now, Element::Ack);
-                let window = 2 * self.config.timeouts.t_ack + self.wire(frame.data.len() + 5);
-                let repeat = frame.stx == Stx::Repeat
-                    && self.last_accepted.as_ref().is_some_and(|(f, at)| {
-                        f.code == frame.code && f.data == frame.data && now <= at + window
+                let answered = self.send(now, Element::Ack);
+                let started = self.rx.started_at();
+                let repeat = frame.stx == self.dialect.repeat_stx()
+                    && self.last_accepted.as_ref().is_some_and(|a| {
+                        let (from, to) = self.dialect.repeat_window(
+                            &self.config.timeouts,
+                            a.end,
+                            a.answered,
+                            self.config.baud,
+                        );
+                        a.frame.code == frame.code
+                            && a.frame.data == frame.data
+                            && (from..=to).contains(&started)
                     });
                 if repeat {
+                    // A repeat is sent once only: the next copy is new.
                     self.last_accepted = None;
                     self.events.push_back(Event::Repeat(frame));
                 } else {
-                    self.last_accepted = (frame.stx == Stx::First).then(|| (frame.clone(), now));
+                    // UM0932 3.2.7: a frame with STX 03h is itself a repeat.
+                    self.last_accepted = (frame.stx == Stx::First).then(|| Accepted {
+                        frame: frame.clone(),
+                        end: now,
+                        answered,
+                    });
                     self.events.push_back(Event::Frame(frame));
                 }
             }
@@ -343,10 +389,6 @@ impl HostEngine {
                 self.last_accepted = None;
             }
         }
-    }
-
-    fn wire(&self, bytes: usize) -> Duration {
-        wire_time(bytes, self.config.baud)
     }
 
     /// Status received: send STX, release T_REQ, send the rest (3.2.8).
@@ -400,7 +442,7 @@ impl HostEngine {
         p.attempts += 1;
         self.transmits.push_back(Transmit::TReq { asserted: true });
         self.state = State::AwaitStatus {
-            deadline: now + self.config.timeouts.t_sr,
+            deadline: now + self.dialect.status_wait(&self.config.timeouts),
         };
     }
 }

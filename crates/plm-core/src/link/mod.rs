@@ -1,4 +1,4 @@
-//! What both chips' host interfaces share (UM0932 3.2, ST7570 UM 4.x):
+//! What both chips' host interfaces share (UM0932 3.2, ST7570 UM 5.2):
 //! local frames and their checksum, ACK/NAK, status messages, the stream
 //! decoder, and the sans-IO link engines.
 
@@ -12,11 +12,11 @@ pub mod host;
 mod rx;
 mod timeouts;
 
-pub use dialect::Dialect;
+pub use dialect::{Answer, Dialect, Reaction};
 pub use element::{Element, GarbageReason, Source, StatusMessage};
 pub use frame::{checksum, EmitError, Frame, FrameError, LocalFrame, Stx};
 pub use stream::StreamDecoder;
-pub use timeouts::Timeouts;
+pub use timeouts::{TicSelector, Timeouts};
 
 /// Acknowledgement character (UM0932 Table 7).
 pub const ACK: u8 = 0x06;

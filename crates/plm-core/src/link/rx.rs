@@ -24,6 +24,9 @@ pub(crate) struct Receiver {
     buf: Vec<u8>,
     partial: Partial,
     last_byte_at: Instant,
+    /// When the first byte of the element being received, or of the last
+    /// one completed, arrived.
+    started_at: Instant,
 }
 
 impl Receiver {
@@ -34,12 +37,20 @@ impl Receiver {
             buf: Vec::new(),
             partial: Partial::None,
             last_byte_at: 0,
+            started_at: 0,
         }
     }
 
     /// Whether a frame or status message is being received.
     pub(crate) fn busy(&self) -> bool {
         matches!(self.partial, Partial::Frame | Partial::Status)
+    }
+
+    /// When the first byte of the element completed last (or being
+    /// received) arrived: the host tells the ST7570's repeat from a new
+    /// frame by it.
+    pub(crate) fn started_at(&self) -> Instant {
+        self.started_at
     }
 
     /// When the partial element must be dropped (or, for garbage, reported).
@@ -126,6 +137,7 @@ impl Receiver {
                             }),
                             p => {
                                 self.partial = p;
+                                self.started_at = now;
                                 self.buf.push(byte);
                             }
                         }
@@ -133,5 +145,60 @@ impl Receiver {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::link::LocalFrame;
+    use alloc::vec;
+
+    /// ST7570 UM 5.2.1: 15h is NAK and CMD_IS_Indication's code, and 06h,
+    /// 15h, 3Fh and 02h may sit inside frames and status messages. What a
+    /// byte means depends on where the receiver is, never on its value.
+    #[test]
+    fn st7570_bytes_mean_what_their_place_says() {
+        let is_ind = LocalFrame::new(NAK, vec![0x01, ACK, NAK, STATUS_FIRST, 0x02]);
+        let mut bytes = vec![STATUS_FIRST, 0x02, ACK, NAK, NAK];
+        bytes.extend(is_ind.emit(Dialect::St7570).unwrap());
+        bytes.push(ACK);
+        let mut rx = Receiver::new(Dialect::St7570, Source::Modem);
+        let mut out = Vec::new();
+        for (i, b) in bytes.iter().enumerate() {
+            rx.push(i as Instant * 100, *b, 1_000, &mut out);
+        }
+        let kinds: Vec<_> = out.iter().map(Element::kind).collect();
+        assert_eq!(kinds, ["status", "nak", "frame", "ack"]);
+        assert_eq!(
+            out[0],
+            Element::Status(StatusMessage::new(Dialect::St7570, &[0x02, ACK, NAK]))
+        );
+        assert!(
+            matches!(&out[2], Element::Frame { frame, checksum_ok: true, .. } if *frame == is_ind)
+        );
+        // The frame began at its STX, the 6th byte.
+        assert_eq!(rx.started_at(), 500);
+    }
+
+    #[test]
+    fn st7570_impossible_length_is_not_a_frame() {
+        // Length 02h < 3 (UM Table 10): garbage, and the NAK after it is
+        // still a NAK.
+        let mut rx = Receiver::new(Dialect::St7570, Source::Modem);
+        let mut out = Vec::new();
+        for b in [0x02, 0x02, 0x90, NAK] {
+            rx.push(0, b, 1_000, &mut out);
+        }
+        assert_eq!(
+            out,
+            vec![
+                Element::Garbage {
+                    bytes: vec![0x02, 0x02, 0x90],
+                    reason: GarbageReason::Unexpected
+                },
+                Element::Nak
+            ]
+        );
     }
 }

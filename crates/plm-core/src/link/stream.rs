@@ -314,4 +314,32 @@ mod tests {
         let chunked: Vec<_> = core::iter::from_fn(|| d.next()).collect();
         assert_eq!(whole, chunked);
     }
+
+    #[test]
+    fn st7570_nak_code_and_control_bytes_inside_elements() {
+        // ST7570 UM 5.2.1: CMD_IS_Indication's code is the NAK byte; ACK,
+        // NAK, `?` and STX bytes sit inside frames and status messages.
+        let is_ind = LocalFrame::new(NAK, vec![0x01, ACK, NAK, STATUS_FIRST, 0x02]);
+        let mut bytes = vec![STATUS_FIRST, 0x02, ACK, NAK, NAK];
+        bytes.extend(is_ind.emit(Dialect::St7570).unwrap());
+        bytes.push(ACK);
+        let els = StreamDecoder::decode_all(Dialect::St7570, Source::Modem, &bytes);
+        let kinds: Vec<_> = els.iter().map(Element::kind).collect();
+        assert_eq!(kinds, ["status", "nak", "frame", "ack"]);
+        assert!(
+            matches!(&els[2], Element::Frame { frame, checksum_ok: true, .. } if *frame == is_ind)
+        );
+        // From the host, `?` starts nothing, and 03h is no STX.
+        let els = StreamDecoder::decode_all(Dialect::St7570, Source::Host, &[0x3F, 0x03, NAK]);
+        assert_eq!(
+            els,
+            vec![
+                Element::Garbage {
+                    bytes: vec![0x3F, 0x03],
+                    reason: GarbageReason::Unexpected
+                },
+                Element::Nak
+            ]
+        );
+    }
 }

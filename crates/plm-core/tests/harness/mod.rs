@@ -1,5 +1,6 @@
 //! A virtual-time bench for the link engines: a [`HostEngine`] and a
-//! [`DeviceEngine`] joined by a simulated UART, byte by byte.
+//! [`DeviceEngine`] of one [`Dialect`] joined by a simulated UART, byte by
+//! byte.
 //!
 //! Model:
 //! - each direction is a UART transmitter at `baud`, 10 bit times per byte
@@ -30,7 +31,7 @@
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, HostEngine, Ticket, Transmit};
 use plm_core::link::{Dialect, Element, LocalFrame, ACK, NAK, STATUS_FIRST};
-use plm_core::time::{wire_time, Duration, Instant};
+use plm_core::time::{wire_time, Duration, Instant, MS};
 use std::collections::VecDeque;
 
 /// A direction on the UART.
@@ -148,8 +149,9 @@ impl Item {
 }
 
 /// Tracks which element each written byte belongs to.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 struct Framer {
+    dialect: Dialect,
     frames: usize,
     statuses: usize,
     /// (is_frame, number, next offset, total length if known)
@@ -157,10 +159,19 @@ struct Framer {
 }
 
 impl Framer {
+    fn new(dialect: Dialect) -> Self {
+        Framer {
+            dialect,
+            frames: 0,
+            statuses: 0,
+            cur: None,
+        }
+    }
+
     fn classify(&mut self, dir: Dir, byte: u8, write_start: bool) -> Part {
         if let Some((is_frame, n, offset, total)) = self.cur {
             let total = if is_frame && offset == 1 {
-                Some(byte as usize + 5)
+                Some(Dialect::frame_len(self.dialect.data_len(byte).unwrap_or(0)))
             } else {
                 total
             };
@@ -172,7 +183,7 @@ impl Framer {
                 Part::Status { n, offset }
             };
         }
-        if write_start && (byte == 0x02 || byte == 0x03) {
+        if write_start && self.dialect.is_stx(byte) {
             let n = self.frames;
             self.frames += 1;
             self.cur = Some((true, n, 1, None));
@@ -181,7 +192,7 @@ impl Framer {
         if write_start && byte == STATUS_FIRST && dir == Dir::DevToHost {
             let n = self.statuses;
             self.statuses += 1;
-            self.cur = Some((false, n, 1, Some(Dialect::St7580.status_len())));
+            self.cur = Some((false, n, 1, Some(self.dialect.status_len())));
             return Part::Status { n, offset: 0 };
         }
         match byte {
@@ -206,7 +217,7 @@ struct Line {
 }
 
 impl Line {
-    fn new(dir: Dir, baud: u32) -> Self {
+    fn new(dialect: Dialect, dir: Dir, baud: u32) -> Self {
         Line {
             dir,
             baud,
@@ -215,7 +226,7 @@ impl Line {
             run_start: 0,
             run_len: 0,
             index: 0,
-            framer: Framer::default(),
+            framer: Framer::new(dialect),
             injectors: Vec::new(),
         }
     }
@@ -297,7 +308,8 @@ impl Line {
     }
 }
 
-type Responder = Box<dyn FnMut(Instant, &LocalFrame) -> Option<LocalFrame>>;
+/// The modem application of a bench: answers a request with a frame, or not.
+pub type Responder = Box<dyn FnMut(Instant, &LocalFrame) -> Option<LocalFrame>>;
 
 /// The bench.
 pub struct Sim {
@@ -337,16 +349,23 @@ pub fn ping_responder() -> Responder {
 }
 
 impl Sim {
-    /// A bench at `baud`; the host gets `config` (its baud is overwritten).
+    /// An ST7580 bench at `baud`; the host gets `config` (its baud is
+    /// overwritten).
     pub fn new(baud: u32, config: HostConfig) -> Self {
+        Sim::new_in(Dialect::St7580, baud, config)
+    }
+
+    /// A bench of `dialect` at `baud`; the host gets `config` (its baud is
+    /// overwritten), the device its reset timeouts.
+    pub fn new_in(dialect: Dialect, baud: u32, config: HostConfig) -> Self {
         let config = HostConfig { baud, ..config };
         Sim {
             now: 0,
             baud,
-            host: HostEngine::new(Dialect::St7580, config),
-            dev: DeviceEngine::new(Dialect::St7580, baud),
-            h2d: Line::new(Dir::HostToDev, baud),
-            d2h: Line::new(Dir::DevToHost, baud),
+            host: HostEngine::new(dialect, config),
+            dev: DeviceEngine::new(dialect, baud),
+            h2d: Line::new(dialect, Dir::HostToDev, baud),
+            d2h: Line::new(dialect, Dir::DevToHost, baud),
             responder: None,
             host_events: Vec::new(),
             dev_events: Vec::new(),
@@ -467,6 +486,13 @@ impl Sim {
     /// Runs everything due up to and including `end`, then sets the clock
     /// to `end`.
     pub fn run_until(&mut self, end: Instant) {
+        self.run(end);
+        self.now = self.now.max(end);
+    }
+
+    /// Runs everything due up to and including `end`; the clock stays at
+    /// the last thing done.
+    fn run(&mut self, end: Instant) {
         let mut same_instant = 0u32;
         self.pump();
         while let Some(next) = self.next_time() {
@@ -515,12 +541,12 @@ impl Sim {
                 self.pump();
             }
         }
-        self.now = self.now.max(end);
     }
 
-    /// Runs until nothing is in flight and no engine waits for a deadline.
+    /// Runs until nothing is in flight and no engine waits for a deadline;
+    /// the clock stays at the last thing done.
     pub fn run_to_idle(&mut self) {
-        self.run_until(Instant::MAX);
+        self.run(Instant::MAX);
         assert_eq!(self.next_time(), None);
     }
 
@@ -620,5 +646,52 @@ impl Sim {
                 _ => None,
             })
             .collect()
+    }
+}
+
+/// A small deterministic generator for the fault injector.
+pub struct XorShift(pub u64);
+
+impl XorShift {
+    /// The next number.
+    pub fn next(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.0 = x;
+        x
+    }
+}
+
+/// Random faults: per byte, `drop_pm`/1000 of a loss or (half as often)
+/// a stall of up to 30 ms, `corrupt_pm`/1000 of a damaged byte; at most
+/// one fault per frame transmission. The limit is the checksum's, not the
+/// engines': UM0932's checksum is a 16-bit sum, which two compensating
+/// errors in one frame pass (see
+/// `additive_checksum_misses_compensating_errors`), while it always sees a
+/// single changed byte.
+pub fn faults(seed: u64, drop_pm: u64, corrupt_pm: u64) -> impl FnMut(&ByteCtx) -> Option<Fault> {
+    let mut rng = XorShift(seed | 1);
+    let mut faulted_frame = None;
+    move |c| {
+        let r = rng.next() % 1000;
+        if let Part::Frame { n, .. } = c.part {
+            if faulted_frame == Some(n) {
+                return None;
+            }
+            if r < drop_pm + corrupt_pm {
+                faulted_frame = Some(n);
+            }
+        }
+        if r < drop_pm / 2 {
+            Some(Fault::Delay(rng.next() % (30 * MS)))
+        } else if r < drop_pm {
+            Some(Fault::Drop)
+        } else if r < drop_pm + corrupt_pm {
+            Some(Fault::Corrupt((rng.next() % 255 + 1) as u8))
+        } else {
+            None
+        }
     }
 }
