@@ -22,7 +22,7 @@ use plm_core::decode::{Decoded, Decoder};
 use plm_core::link::host::{self, Transmit};
 use plm_core::link::{Dialect, Element, Source};
 use plm_core::time::{Duration, Instant, MS};
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::{BTreeMap, VecDeque};
 
 /// Samples of a lamp's history kept for its plots.
 pub const HISTORY: usize = 240;
@@ -144,7 +144,8 @@ pub struct StreetSession {
     sweep_queue: VecDeque<Address>,
     next_sweep: Option<Instant>,
     fleet: BTreeMap<Address, Lamp>,
-    purposes: HashMap<RequestId, Purpose>,
+    /// What each request under way is for (a few at a time: a list).
+    purposes: Vec<(RequestId, Purpose)>,
     /// Names the modem's host-interface traffic (bare modem profile).
     decoder: Decoder,
     out: StreetTick,
@@ -165,7 +166,7 @@ impl StreetSession {
             sweep_queue: VecDeque::new(),
             next_sweep: None,
             fleet: BTreeMap::new(),
-            purposes: HashMap::new(),
+            purposes: Vec::new(),
             decoder: Decoder::new(Dialect::St7580, Source::Any),
             out: StreetTick::default(),
             campaign: None,
@@ -300,7 +301,7 @@ impl StreetSession {
         }
         let now = self.now();
         let id = self.conc.submit(now, request);
-        self.purposes.insert(id, purpose);
+        self.purposes.push((id, purpose));
         self.flush();
     }
 
@@ -483,7 +484,7 @@ impl StreetSession {
                 answer,
                 ..
             } => {
-                let purpose = self.purposes.remove(&id);
+                let purpose = self.purpose(id);
                 self.answered(now, address);
                 if let Some(p) = purpose {
                     self.fulfil(now, p, Ok(answer));
@@ -494,7 +495,7 @@ impl StreetSession {
                 address,
                 reason,
             } => {
-                if let Some(p) = self.purposes.remove(&id) {
+                if let Some(p) = self.purpose(id) {
                     let unicast = !matches!(p, Purpose::View(_)) || address != Address::BROADCAST;
                     if unicast && self.fleet.contains_key(&address) {
                         self.unreachable(now, address, &reason);
@@ -503,12 +504,18 @@ impl StreetSession {
                 }
             }
             AppEvent::Sent { id } => {
-                if let Some(p) = self.purposes.remove(&id) {
+                if let Some(p) = self.purpose(id) {
                     self.fulfil(now, p, Ok(Message::Ping));
                 }
             }
             AppEvent::Retry { .. } | AppEvent::Malformed { .. } => {}
         }
+    }
+
+    /// Takes what request `id` was for.
+    fn purpose(&mut self, id: RequestId) -> Option<Purpose> {
+        let i = self.purposes.iter().position(|(r, _)| *r == id)?;
+        Some(self.purposes.swap_remove(i).1)
     }
 
     /// Any answer shows the lamp is there.

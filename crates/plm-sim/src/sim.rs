@@ -21,7 +21,7 @@ use plm_core::mib::MibError;
 use plm_core::st7580::{Channel, Command, Modulation, ResetCause, Temperature};
 use plm_core::time::{earliest, Duration, Instant};
 use std::cmp::Reverse;
-use std::collections::{BTreeSet, BinaryHeap, VecDeque};
+use std::collections::{BinaryHeap, VecDeque};
 
 /// How a simulation starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -309,7 +309,10 @@ pub struct Sim {
     is_dirty: Vec<bool>,
     /// Each node's earliest component deadline, and all of them ordered.
     deadlines: Vec<Option<Instant>>,
-    timers: BTreeSet<(Instant, usize)>,
+    /// Earliest first; an entry is current while `deadlines` holds it
+    /// (older ones are dropped when they come to the top): a heap, so
+    /// that the console's wasm carries no B-tree code for it.
+    timers: BinaryHeap<Reverse<(Instant, usize)>>,
 }
 
 impl Sim {
@@ -381,7 +384,7 @@ impl Sim {
             dirty: Vec::new(),
             is_dirty: Vec::new(),
             deadlines: Vec::new(),
-            timers: BTreeSet::new(),
+            timers: BinaryHeap::new(),
         };
         let n = sim.nodes.len();
         sim.is_dirty = vec![false; n];
@@ -408,13 +411,22 @@ impl Sim {
         let n = &self.nodes[node];
         let d = earliest(n.modem.poll_timeout(), n.host.poll_timeout());
         if d != self.deadlines[node] {
-            if let Some(old) = self.deadlines[node] {
-                self.timers.remove(&(old, node));
-            }
             if let Some(new) = d {
-                self.timers.insert((new, node));
+                self.timers.push(Reverse((new, node)));
             }
             self.deadlines[node] = d;
+            self.drop_stale_timers();
+        }
+    }
+
+    /// Keeps the heap's top current: entries a node's new deadline
+    /// replaced go.
+    fn drop_stale_timers(&mut self) {
+        while let Some(Reverse((t, node))) = self.timers.peek() {
+            if self.deadlines[*node] == Some(*t) {
+                break;
+            }
+            self.timers.pop();
         }
     }
 
@@ -625,7 +637,7 @@ impl Sim {
     pub fn next_deadline(&self) -> Option<Instant> {
         earliest(
             self.queue.peek().map(|s| s.0.at),
-            self.timers.first().map(|t| t.0),
+            self.timers.peek().map(|t| t.0 .0),
         )
     }
 
@@ -676,12 +688,19 @@ impl Sim {
             self.dispatch(s.ev);
             self.flush();
         }
-        let due: Vec<usize> = self
-            .timers
-            .iter()
-            .take_while(|t| t.0 <= now)
-            .map(|t| t.1)
-            .collect();
+        let mut due: Vec<usize> = Vec::new();
+        while let Some(Reverse((t, node))) = self.timers.peek().copied() {
+            if t > now {
+                break;
+            }
+            self.timers.pop();
+            if self.deadlines[node] == Some(t) {
+                // Filed again by `touch` below if still due later.
+                self.deadlines[node] = None;
+                due.push(node);
+            }
+        }
+        self.drop_stale_timers();
         for i in due {
             let Sim { nodes, rng, .. } = self;
             let n = &mut nodes[i];
