@@ -259,6 +259,24 @@ impl Field {
         self
     }
 
+    /// The same field narrowed to bits `lo .. lo+width` of its bytes read
+    /// as one number (ST7570 UM Table 38: the 24-bit ADDRESS holds SA in
+    /// b23..b12 and DA in b11..b0).
+    pub const fn within(mut self, lo: u8, width: u8) -> Field {
+        self.bits = Some((lo, width));
+        self.min = 0;
+        self.max = (1i64 << width) - 1;
+        self
+    }
+
+    /// The same field `by` bytes further on: one description of a sub-field
+    /// that several tables place at different offsets (ST7570 UM Tables 17
+    /// and 18 put S0..N1 at byte 0 and at byte 1).
+    pub const fn shifted(mut self, by: usize) -> Field {
+        self.offset += by;
+        self
+    }
+
     /// Number of bytes this field needs in `data` (to its last byte).
     pub fn end(&self) -> usize {
         self.offset + self.size
@@ -414,6 +432,19 @@ impl Field {
     }
 }
 
+/// The names of a byte-wide enumeration whose defined values are sparse
+/// (ST7570 UM Table 43: 00h..06h and FFh = LP_OK), indexed by raw value;
+/// the values not listed have an empty name (undefined, refused).
+pub const fn sparse_names(pairs: &[(u8, &'static str)]) -> [&'static str; 256] {
+    let mut names = [""; 256];
+    let mut i = 0;
+    while i < pairs.len() {
+        names[pairs[i].0 as usize] = pairs[i].1;
+        i += 1;
+    }
+    names
+}
+
 /// Checks every settable field of `layout` in `data`; the first error wins.
 pub fn validate(layout: &[Field], data: &[u8]) -> Result<(), FieldError> {
     for f in layout {
@@ -470,6 +501,32 @@ mod tests {
         assert!(f.check(3).is_err());
         assert_eq!(f.read(&[2]), Some(Value::Enum { raw: 2, name: None }));
         assert_eq!(f.allowed(), "0 = zero, 1 = one");
+    }
+
+    #[test]
+    fn narrowed_multi_byte_fields_and_shifts() {
+        // ST7570 UM 10.4.2: ADDRESS 00.1C.00h = SA 001h, DA C00h.
+        let sa = Field::uint("sa", "SA", 0, 3).within(12, 12);
+        let da = Field::uint("da", "DA", 0, 3).within(0, 12);
+        let mut d = [0x00, 0x1C, 0x00];
+        assert_eq!((sa.get(&d), da.get(&d)), (Some(0x001), Some(0xC00)));
+        assert_eq!(sa.max, 0xFFF);
+        sa.set(&mut d, 0xC00);
+        da.set(&mut d, 0x001);
+        assert_eq!(d, [0xC0, 0x00, 0x01]);
+        let s0 = Field::uint("s0", "S0", 0, 3)
+            .order(Order::LsbFirst)
+            .shifted(1);
+        assert_eq!(s0.get(&[0x01, 0xDF, 0x28, 0x00]), Some(0x28DF));
+    }
+
+    #[test]
+    fn sparse_names_leave_gaps_undefined() {
+        const N: [&str; 256] = sparse_names(&[(0x00, "LP_TU"), (0xFF, "LP_OK")]);
+        let f = Field::enumeration("c", "C", 0, 0, 8, &N);
+        assert!(f.check(0xFF).is_ok());
+        assert!(f.check(0x01).is_err());
+        assert_eq!(f.allowed(), "0 = LP_TU, 255 = LP_OK");
     }
 
     #[test]

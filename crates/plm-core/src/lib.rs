@@ -9,6 +9,8 @@
 //! - [`link`]: local frames, checksum, ACK/NAK, status messages, the stream
 //!   decoder and the sans-IO host and device link engines (UM0932 3.2).
 //! - [`st7580`]: every ST7580 command (UM0932 3.3) and MIB object (UM0932 4).
+//! - [`st7570`]: every ST7570 command (ST7570 UM 5.3) in PHY and MAC mode,
+//!   its status message (Table 11) and MIB objects (ST7570 UM 6).
 //! - [`field`]: the declarative field layouts that both the typed codecs and
 //!   the generic decoder/forms read, so a bit position is written once.
 //! - [`mib`]: the declarative MIB description (objects, access, defaults).
@@ -38,5 +40,6 @@ pub mod hex;
 pub mod json;
 pub mod link;
 pub mod mib;
+pub mod st7570;
 pub mod st7580;
 pub mod time;

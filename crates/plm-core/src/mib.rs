@@ -39,15 +39,48 @@ impl Access {
         write: false,
         erase: true,
     };
+    /// W: written, never read (ST7570 UM 6.5.29, 00A0h).
+    pub const W: Access = Access {
+        read: false,
+        write: true,
+        erase: false,
+    };
 
-    /// As the manual writes it: `R`, `R/W`, `R/E`.
+    /// As the manual writes it: `R`, `R/W`, `R/E`, `W`.
     pub fn label(self) -> &'static str {
-        match (self.write, self.erase) {
-            (true, _) => "R/W",
-            (_, true) => "R/E",
+        match (self.read, self.write, self.erase) {
+            (true, true, _) => "R/W",
+            (false, true, _) => "W",
+            (_, _, true) => "R/E",
             _ => "R",
         }
     }
+}
+
+/// Where an object may be used. The ST7570 knows some objects only in one
+/// access layer (ST7570 UM 6.5: ERR_UNAVAILABLE_RESOURCE "the modem is not
+/// configured as MAC") and refuses some writes in some operating modes
+/// (ERR_REQUEST_NOT_ALLOWED "the modem is configured as Monitor"). The
+/// ST7580 has no such limits ([`Scope::ANY`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scope {
+    /// The object exists with the PHY access layer.
+    pub phy: bool,
+    /// The object exists with the MAC access layer.
+    pub mac: bool,
+    /// Operating modes in which a write is allowed: bit n is mode n of
+    /// ST7570 MIB 00A1h byte 0 (0 IDLE, 1 Client, 2 Server, 3 Monitor,
+    /// 4-6 Test).
+    pub write_modes: u8,
+}
+
+impl Scope {
+    /// Every layer, every mode.
+    pub const ANY: Scope = Scope {
+        phy: true,
+        mac: true,
+        write_modes: 0xFF,
+    };
 }
 
 /// One MIB object.
@@ -67,6 +100,13 @@ pub struct Object {
     pub default: &'static [u8],
     /// Its fields.
     pub fields: &'static [Field],
+    /// The layout of a write request's data when it is not the value
+    /// itself (ST7570 UM 6.5: a counter is reset by 4 PAD bytes, 0082h is
+    /// written with 2 of the 3 bytes it confirms); `None` when a write
+    /// carries the value.
+    pub write: Option<&'static [Field]>,
+    /// Where the object may be used.
+    pub scope: Scope,
 }
 
 /// Why a MIB operation is refused, in words.
@@ -78,6 +118,8 @@ pub enum MibError {
     NotWritable(&'static str),
     /// The object cannot be erased.
     NotErasable(&'static str),
+    /// The object cannot be read (ST7570 00A0h is written only).
+    NotReadable(&'static str),
     /// The value has the wrong length.
     WrongLength {
         /// Object name.
@@ -97,6 +139,7 @@ impl fmt::Display for MibError {
             MibError::UnknownObject(i) => write!(f, "there is no MIB object {i:02X}h"),
             MibError::NotWritable(n) => write!(f, "{n} is read-only"),
             MibError::NotErasable(n) => write!(f, "{n} cannot be erased"),
+            MibError::NotReadable(n) => write!(f, "{n} is written only, it cannot be read"),
             MibError::WrongLength {
                 object,
                 expected,
@@ -115,12 +158,45 @@ impl Object {
         describe(self.fields, data)
     }
 
-    /// The checks the chip applies to a MIB_WriteRequest of this object.
+    /// The checks the chip applies to a MIB_WriteRequest of this object:
+    /// access, then the length and fields of the write layout.
     pub fn check_write(&self, data: &[u8]) -> Result<(), MibError> {
         if !self.access.write {
             return Err(MibError::NotWritable(self.name));
         }
-        self.check_value(data)
+        let Some(layout) = self.write else {
+            return self.check_value(data);
+        };
+        if data.len() != self.write_len() {
+            return Err(MibError::WrongLength {
+                object: self.name,
+                expected: self.write_len(),
+                got: data.len(),
+            });
+        }
+        field::validate(layout, data).map_err(MibError::Field)
+    }
+
+    /// The layout of a write request's data.
+    pub fn write_fields(&self) -> &'static [Field] {
+        self.write.unwrap_or(self.fields)
+    }
+
+    /// Bytes of a write request's data.
+    pub fn write_len(&self) -> usize {
+        match self.write {
+            Some(layout) => layout.iter().map(Field::end).max().unwrap_or(0),
+            None => self.len,
+        }
+    }
+
+    /// The checks the chip applies to a read request of this object.
+    pub fn check_read(&self) -> Result<(), MibError> {
+        if self.access.read {
+            Ok(())
+        } else {
+            Err(MibError::NotReadable(self.name))
+        }
     }
 
     /// Checks a value (length and every field) without regard to access.

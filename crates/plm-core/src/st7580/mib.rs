@@ -8,7 +8,7 @@ use super::types::{DataConfirm, IndicationInfo};
 use super::ErrorCause;
 use crate::field::Field;
 use crate::link::Timeouts;
-use crate::mib::{self as m, Access, MibError, Object};
+use crate::mib::{self as m, Access, MibError, Object, Scope};
 use alloc::vec::Vec;
 
 /// MIB object indexes (Table 52).
@@ -318,6 +318,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::RW,
         default: &[0x11],
         fields: modem_config::LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x01,
@@ -329,6 +331,8 @@ pub const OBJECTS: &[Object] = &[
             0x01, 0x4F, 0xF0, 0x01, 0x19, 0x40, 0x0E, 0x15, 0x00, 0x00, 0x02, 0x35, 0x9B, 0x58,
         ],
         fields: phy_config::LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x02,
@@ -338,6 +342,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::RW,
         default: &[0; 16],
         fields: SS_KEY_LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x03,
@@ -347,6 +353,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::R,
         default: &[0],
         fields: RESERVED_LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x04,
@@ -356,6 +364,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::R,
         default: &[0; 4],
         fields: indication_data::LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x05,
@@ -365,6 +375,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::R,
         default: &[0; 5],
         fields: confirm_data::LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x06,
@@ -374,6 +386,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::RE,
         default: &[0; 10],
         fields: PHY_DATA_LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x07,
@@ -383,6 +397,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::RE,
         default: &[0; 8],
         fields: DL_DATA_LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x08,
@@ -392,6 +408,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::RE,
         default: &[0; 10],
         fields: SS_DATA_LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x09,
@@ -401,6 +419,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::RW,
         default: &[0xC8, 0x28, 0x0A],
         fields: host_interface_timeout::LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
     Object {
         index: 0x0A,
@@ -410,6 +430,8 @@ pub const OBJECTS: &[Object] = &[
         access: Access::R,
         default: &[0x00, 0x42, 0x00, 0x97],
         fields: FIRMWARE_VERSION_LAYOUT,
+        write: None,
+        scope: Scope::ANY,
     },
 ];
 
