@@ -424,3 +424,52 @@ test('WebSerial: a concentrator board on the port: its street is found, read and
   assert.equal(wire.clients.flatMap((c) => c.log).filter((e) => e.rts === true).length, 0);
   await shot(page, 'webserial-street');
 });
+
+test('WebSerial: a firmware update over a real street survives a pulled cable and resumes where it was', async (t) => {
+  const { page, wire } = await open(t, { world: ['--board', '--street', '3', '--seed', '5'], profile: 'board' });
+  await connectSerial(page, { reset: false });
+  const lit = (n) =>
+    page.waitForFunction(
+      (count) => {
+        const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+        return cells.length === count && cells.every((c) => c.textContent === 'RUN');
+      },
+      n,
+      { timeout: 90_000, polling: 250 },
+    );
+  await lit(3);
+  await tab(page, 'update');
+  await page.fill('#update-make-release', '1.6');
+  await page.fill('#update-make-size', '3000');
+  await page.click('#update-make');
+  await page.selectOption('#update-targets', 'all');
+  await page.click('#update-start');
+  await page.waitForFunction(() => Number(document.querySelector('#update-progress')?.value) > 150, null, {
+    timeout: 60_000,
+  });
+  // The adapter is pulled out mid-update: the campaign stays in the
+  // browser's storage; plugged back in, the view offers it again.
+  await page.evaluate(() => window.__plmSerialShim.unplug());
+  await page.locator('#conn-state:not(.ok)').waitFor();
+  await page.evaluate(() => window.__plmSerialShim.replug());
+  await connectSerial(page, { grant: false, reset: false });
+  await tab(page, 'update');
+  const banner = page.locator('#update-saved');
+  await banner.waitFor();
+  assert.match(await banner.textContent(), /release 1\.6 to 3 lamp\(s\), 3000-byte image/);
+  await page.click('#update-resume');
+  await page
+    .locator('#update-summary', { hasText: 'to 3 lamp(s): 3 updated, 0 not updated · took' })
+    .waitFor({ timeout: 120_000 });
+  await shot(page, 'webserial-update');
+  assert.equal(wire.clients.length, 2, 'one connection before the cable was pulled, one after');
+  // The boards run it: read back from the street's own answers.
+  await tab(page, 'street');
+  for (let n = 1; n <= 3; n++) {
+    await page.waitForFunction(
+      (sel) => document.querySelector(sel)?.textContent === '1.6',
+      `#fleet-table tr[data-address="0080e100000${n}"] td[data-key="firmware"]`,
+      { timeout: 60_000 },
+    );
+  }
+});
