@@ -4,14 +4,18 @@
 //! the chip applies (6.3), typed, with parse and emit. Every layout is a
 //! list of [`crate::field::Field`]s in [`fields`], [`status`] and [`mib`],
 //! read by the typed codecs, the decoder, console forms and the simulator.
+//! [`mac`] and [`phy_frame`] are the IEC 61334-5-1 frames on the line
+//! itself (4.4, 3.2), for the simulated line and for line captures.
 
 pub mod code;
 mod command;
 mod emit;
 pub mod fields;
 mod layout;
+pub mod mac;
 pub mod mib;
 mod mib_table;
+pub mod phy_frame;
 pub mod status;
 mod types;
 pub mod validate;
