@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use plm_cli::{board, sim_server};
 use plm_core::decode::Decoder;
 use plm_core::link::{Dialect, Source};
+use plm_core::st7570::Layer;
 use std::io::{self, BufWriter, Read, Write};
 use std::process::ExitCode;
 
@@ -41,6 +42,15 @@ enum Chip {
     St7570,
 }
 
+/// An ST7570 access layer (MIB 00A1h Access layer mode).
+#[derive(Clone, Copy, ValueEnum)]
+enum LayerArg {
+    /// Physical layer mode.
+    Phy,
+    /// MAC layer mode.
+    Mac,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum From {
     /// Bytes the host sent (no status messages).
@@ -56,15 +66,20 @@ struct DecodeArgs {
     chip: Option<Chip>,
     /// Decode a street-light controller board's USART instead: application
     /// frames with CRC-16 (STEVAL-IHP007V1 UM 4.6).
-    #[arg(long, conflicts_with_all = ["chip", "from", "mib_index"])]
+    #[arg(long, conflicts_with_all = ["chip", "from", "mib_index", "layer"])]
     board: bool,
     /// Who sent the bytes (default: either).
     #[arg(long, value_enum)]
     from: Option<From>,
     /// Name MIB_ReadConfirm frames as this object (hex or decimal index)
-    /// when the MIB_ReadRequest is not part of the input.
+    /// when the MIB_ReadRequest is not part of the input (ST7580).
     #[arg(long, value_parser = parse_index)]
     mib_index: Option<u8>,
+    /// Read every frame in this access layer (ST7570), whatever the
+    /// input's status messages and MIB 00A1h frames say; without it, PHY
+    /// until they say otherwise.
+    #[arg(long, value_enum)]
+    layer: Option<LayerArg>,
     /// Hex bytes (spaces, dots, colons allowed); read from stdin if absent.
     hex: Vec<String>,
 }
@@ -217,8 +232,20 @@ fn decode(args: DecodeArgs) -> Result<(), String> {
         None => Source::Any,
     };
     let mut decoder = Decoder::new(dialect, source);
-    if let Some(i) = args.mib_index {
-        decoder.assume_mib_read(i);
+    match (dialect, args.mib_index, args.layer) {
+        (Dialect::St7570, Some(_), _) => {
+            return Err(
+                "--mib-index is for the ST7580: an ST7570 CMD_ReadDBConfirm carries its INDEX"
+                    .into(),
+            )
+        }
+        (Dialect::St7580, _, Some(_)) => {
+            return Err("--layer is for the ST7570: the ST7580 has one frame layout".into())
+        }
+        (_, Some(i), _) => decoder.assume_mib_read(i),
+        (_, _, Some(LayerArg::Phy)) => decoder.fix_layer(Layer::Phy),
+        (_, _, Some(LayerArg::Mac)) => decoder.fix_layer(Layer::Mac),
+        _ => {}
     }
     decoder.push(&bytes);
     decoder.finish();

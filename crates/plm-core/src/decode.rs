@@ -7,17 +7,21 @@
 //! - frames: `stx`, `length`, `code`, `command` (the manual's name, `null`
 //!   for an unknown code), `checksum`, `checksum_ok`, and `fields` named
 //!   after the manual's labels in snake_case;
-//! - `error` when the data does not fit the command, `reason` for garbage;
-//! - DL_DataRequest, DL_DataIndication and DL_SnifferIndication: `app` in
-//!   `fields`, the application frame the DL payload carries
-//!   ([`crate::decode_app`]), when it can be one.
+//! - `error` when the data does not fit the command, `reason` for garbage.
+//!
+//! What differs between the chips is answered by the chip's module, chosen
+//! once from the dialect ([`Chip::new`]): [`st7580`] (MIB_ReadConfirm named
+//! by the request before it; DL payloads carrying application frames)
+//! and [`st7570`] (the access layer the frames are read in, named in
+//! `layer`; MIB frames that carry their index).
+
+mod st7570;
+mod st7580;
 
 use crate::field::{Field, Value};
 use crate::hex;
 use crate::json::{json_record, Json, Object};
-use crate::link::{Dialect, Element, GarbageReason, Source, StreamDecoder};
-use crate::st7580::fields::{indication_data, reset_data, status, tx_options};
-use crate::st7580::{self, code as c, Command};
+use crate::link::{Dialect, Element, GarbageReason, LocalFrame, Source, StreamDecoder};
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
@@ -38,6 +42,9 @@ pub struct Decoded {
     pub code: Option<u8>,
     /// The manual's command name; `null` for a code it does not define.
     pub command: Option<Json>,
+    /// The access layer a frame was read in, or a status message gives
+    /// (`PHY` or `MAC`; ST7570 only).
+    pub layer: Option<String>,
     /// The checksum as received (frames).
     pub checksum: Option<u16>,
     /// Whether the checksum is right (frames).
@@ -59,6 +66,7 @@ json_record!(Decoded {
     length,
     code,
     command,
+    layer,
     checksum,
     checksum_ok,
     fields,
@@ -80,25 +88,62 @@ pub fn json_value(v: &Value) -> Json {
     }
 }
 
+/// The named values of `data` under `layout`, in `map`.
 pub(crate) fn put_layout(map: &mut Object, layout: &'static [Field], data: &[u8]) {
     for (f, v) in crate::mib::describe(layout, data) {
         map.insert(f.name, json_value(&v));
     }
 }
 
-fn put_hex(map: &mut Object, key: &str, bytes: &[u8]) {
+pub(crate) fn put_hex(map: &mut Object, key: &str, bytes: &[u8]) {
     map.insert(key, Json::String(hex::encode(bytes)));
 }
 
+/// The chip whose host interface is decoded, with the context its frames
+/// need that a single frame lacks.
+#[derive(Debug, Clone)]
+enum Chip {
+    St7580(st7580::Context),
+    St7570(st7570::Context),
+}
+
+impl Chip {
+    /// The one place where the dialect picks the chip's decoding.
+    fn new(dialect: Dialect) -> Chip {
+        match dialect {
+            Dialect::St7580 => Chip::St7580(st7580::Context::default()),
+            Dialect::St7570 => Chip::St7570(st7570::Context::default()),
+        }
+    }
+
+    /// Command name, layer, fields and error of a frame sent by `from`.
+    fn frame(&mut self, from: Source, frame: &LocalFrame, d: &mut Decoded) {
+        match self {
+            Chip::St7580(c) => c.frame(frame, d),
+            Chip::St7570(c) => c.frame(from, frame, d),
+        }
+    }
+
+    /// Fields (and layer) of a status message: its bytes after `?`.
+    fn status(&mut self, data: &[u8], d: &mut Decoded) {
+        match self {
+            Chip::St7580(_) => st7580::status(data, d),
+            Chip::St7570(c) => c.status(data, d),
+        }
+    }
+}
+
 /// Decodes a host-interface stream into [`Decoded`] elements, keeping the
-/// context a single frame lacks (the index of a pending MIB_ReadRequest,
-/// which names the object in the following MIB_ReadConfirm).
+/// context a single frame lacks: for the ST7580 the index of a pending
+/// MIB_ReadRequest, which names the object of the following
+/// MIB_ReadConfirm; for the ST7570 the access layer (and operating mode)
+/// the last status message or MIB 00A1h frame set.
 #[derive(Debug, Clone)]
 pub struct Decoder {
     dialect: Dialect,
     source: Source,
     stream: StreamDecoder,
-    pending_read: Option<u8>,
+    chip: Chip,
 }
 
 impl Decoder {
@@ -108,14 +153,27 @@ impl Decoder {
             dialect,
             source,
             stream: StreamDecoder::new(dialect, source),
-            pending_read: None,
+            chip: Chip::new(dialect),
         }
     }
 
     /// Names the object of MIB_ReadConfirm frames when the request is not
-    /// in the input (a capture of the modem side only).
+    /// in the input (a capture of the modem side only). ST7580 only: an
+    /// ST7570 CMD_ReadDBConfirm carries its INDEX.
     pub fn assume_mib_read(&mut self, index: u8) {
-        self.pending_read = Some(index);
+        if let Chip::St7580(c) = &mut self.chip {
+            c.assume_mib_read(index);
+        }
+    }
+
+    /// Reads every ST7570 frame in `layer`, whatever status messages and
+    /// MIB 00A1h frames in the input say (`plm decode --layer`). Without
+    /// it the layer is PHY (the factory default of 00A1h) until the input
+    /// says otherwise. No effect on an ST7580 decoder.
+    pub fn fix_layer(&mut self, layer: crate::st7570::Layer) {
+        if let Chip::St7570(c) = &mut self.chip {
+            c.fix_layer(layer);
+        }
     }
 
     /// Feeds bytes.
@@ -135,7 +193,7 @@ impl Decoder {
         Some(self.decode(&e))
     }
 
-    /// Decodes one element (updating the MIB read context).
+    /// Decodes one element (updating the context).
     pub fn decode(&mut self, e: &Element) -> Decoded {
         let mut d = Decoded {
             kind: e.kind().to_string(),
@@ -149,6 +207,7 @@ impl Decoder {
             length: None,
             code: None,
             command: None,
+            layer: None,
             checksum: None,
             checksum_ok: None,
             fields: None,
@@ -166,33 +225,9 @@ impl Decoder {
                 d.code = Some(frame.code);
                 d.checksum = Some(*checksum);
                 d.checksum_ok = Some(*checksum_ok);
-                if self.dialect == Dialect::St7580 {
-                    d.command =
-                        Some(c::name(frame.code).map_or(Json::Null, |n| Json::String(n.into())));
-                    let mut fields = Object::new();
-                    match Command::parse(frame.code, &frame.data) {
-                        Ok(cmd) => d.error = self.command_fields(&cmd, &frame.data, &mut fields),
-                        Err(err) => {
-                            put_hex(&mut fields, "data", &frame.data);
-                            d.error = Some(err.to_string());
-                        }
-                    }
-                    d.fields = Some(fields);
-                } else {
-                    let mut fields = Object::new();
-                    put_hex(&mut fields, "data", &frame.data);
-                    d.fields = Some(fields);
-                }
+                self.chip.frame(self.source, frame, &mut d);
             }
-            Element::Status(s) => {
-                let mut fields = Object::new();
-                if self.dialect == Dialect::St7580 {
-                    put_layout(&mut fields, status::LAYOUT, s.data());
-                } else {
-                    put_hex(&mut fields, "data", s.data());
-                }
-                d.fields = Some(fields);
-            }
+            Element::Status(s) => self.chip.status(s.data(), &mut d),
             Element::Garbage { reason, .. } => {
                 d.reason = Some(
                     match reason {
@@ -205,134 +240,6 @@ impl Decoder {
             Element::Ack | Element::Nak => {}
         }
         d
-    }
-
-    /// Fills `f` with the named fields of `cmd`; returns what the modem
-    /// would refuse about it, if anything.
-    /// `data` is the frame's data field, from which the layouts read
-    /// directly (nothing is re-encoded).
-    fn command_fields(&mut self, cmd: &Command, data: &[u8], f: &mut Object) -> Option<String> {
-        use Command::*;
-        let mut problem = None;
-        match cmd {
-            BioResetRequest | MibWriteConfirm | MibEraseConfirm => {}
-            BioResetConfirm { confirm_data } => {
-                f.insert("confirm_data", Json::from(*confirm_data));
-            }
-            BioResetError(e) | MibWriteError(e) | MibReadError(e) | MibEraseError(e)
-            | PhyDataError(e) | DlDataError(e) | SsDataError(e) => {
-                f.insert(
-                    "error_data",
-                    e.name()
-                        .map_or(Json::from(e.byte()), |n| Json::String(n.into())),
-                );
-            }
-            BioResetIndication(r) => put_layout(f, reset_data::LAYOUT, &[r.byte()]),
-            MibWriteRequest { index, data } => {
-                problem = put_object(f, *index, data);
-                if let Err(e) = st7580::mib::check_write(*index, data) {
-                    problem = Some(alloc::format!("the modem will refuse this write: {e}"));
-                }
-            }
-            MibReadRequest { index } | MibEraseRequest { index } => {
-                f.insert("index", Json::from(*index));
-                let name = st7580::mib::object(*index).map(|o| o.name);
-                f.insert(
-                    "object",
-                    name.map_or(Json::Null, |n| Json::String(n.into())),
-                );
-                if matches!(cmd, MibReadRequest { .. }) {
-                    self.pending_read = Some(*index);
-                }
-            }
-            MibReadConfirm { data } => match self.pending_read.take() {
-                Some(index) => problem = put_object(f, index, data),
-                None => put_hex(f, "data", data),
-            },
-            PingRequest { data } | PingConfirm { data } | Unknown { data, .. } => {
-                put_hex(f, "data", data)
-            }
-            PhyDataRequest(r) | DlDataRequest(r) => {
-                put_tx_params(f, data, &r.params);
-                put_hex(f, "payload", &r.payload);
-                if matches!(cmd, DlDataRequest(_)) {
-                    put_app(f, &r.payload);
-                }
-            }
-            SsDataRequest(r) => {
-                put_tx_params(f, data, &r.params);
-                f.insert(tx_options::HEADER_LENGTH.name, Json::from(r.header_length));
-                put_hex(f, "header_and_payload", &r.header_and_payload);
-            }
-            PhyDataConfirm(_) | DlDataConfirm(_) | SsDataConfirm(_) => {
-                put_layout(f, st7580::fields::confirm_data::LAYOUT, data)
-            }
-            PhyDataIndication(i)
-            | DlDataIndication(i)
-            | DlSnifferIndication(i)
-            | SsDataIndication(i)
-            | SsSnifferIndication(i) => {
-                put_layout(f, indication_data::LAYOUT, data);
-                let key = match cmd {
-                    PhyDataIndication(_) => "phy_payload",
-                    DlDataIndication(_) => "dl_payload",
-                    DlSnifferIndication(_) => "dl_payload_and_wrong_crc",
-                    SsDataIndication(_) => "ss_header_and_payload",
-                    _ => "ss_sdu",
-                };
-                put_hex(f, key, &i.payload);
-                if matches!(cmd, DlDataIndication(_) | DlSnifferIndication(_)) {
-                    put_app(f, &i.payload);
-                }
-            }
-            CmdSyntaxError { error } => {
-                f.insert("error", Json::from(*error));
-            }
-        }
-        problem
-    }
-}
-
-/// Index, object name and fields of a MIB value; a problem if the value
-/// does not fit the object.
-fn put_object(f: &mut Object, index: u8, data: &[u8]) -> Option<String> {
-    f.insert("index", Json::from(index));
-    let Some(o) = st7580::mib::object(index) else {
-        f.insert("object", Json::Null);
-        put_hex(f, "data", data);
-        return Some(alloc::format!("there is no MIB object {index:02X}h"));
-    };
-    f.insert("object", Json::String(o.name.into()));
-    put_hex(f, "data", data);
-    if data.len() != o.len {
-        return Some(alloc::format!(
-            "{} is {} bytes long, not {}",
-            o.name,
-            o.len,
-            data.len()
-        ));
-    }
-    put_layout(f, o.fields, data);
-    None
-}
-
-/// The application frame a DL payload carries over the power line
-/// (`app::line`), under the key `app`, when the payload can be one. A
-/// sniffed frame's payload still ends with its wrong DL CRC, whose length
-/// the indication does not give: it shows as the last payload bytes.
-fn put_app(f: &mut Object, payload: &[u8]) {
-    if let Some(line) = crate::app::LineFrame::parse(payload) {
-        f.insert("app", crate::decode_app::decode_line(&line).to_json());
-    }
-}
-
-fn put_tx_params(f: &mut Object, bytes: &[u8], p: &st7580::TxParams) {
-    put_layout(f, tx_options::LAYOUT, bytes);
-    if let Some(hz) = p.tx_frequency {
-        f.insert(tx_options::TX_FREQUENCY.name, Json::from(hz));
-    }
-    if let Some(g) = p.tx_gain {
-        f.insert(tx_options::TX_GAIN.name, Json::from(g));
     }
 }
 

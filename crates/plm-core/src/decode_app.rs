@@ -136,6 +136,7 @@ impl AppDecoded {
             length: self.length,
             code: None,
             command: self.command.clone().or_else(|| self.frame_type.clone()),
+            layer: None,
             checksum: self.crc,
             checksum_ok: self.crc_ok,
             fields: Some(fields),
