@@ -1,12 +1,19 @@
 //! `cargo xtask bench`: throughput of the stream decoder and allocations per
-//! decoded frame, measured natively.
+//! decoded frame, measured natively, per chip.
 //!
-//! Method: a deterministic 4 MiB capture of a busy ST7580 host interface
-//! (status messages, requests, confirms, indications with 16-250 byte
-//! payloads, ACKs, 1 % garbage bytes) is decoded in 4 KiB chunks, as a
-//! serial port delivers it. Each figure is the median of 7 runs after one
-//! warm-up run. Allocations are counted by a counting global allocator
-//! around the decoding loop only, divided by the frames decoded.
+//! Method: a deterministic 4 MiB capture of a busy host interface is
+//! decoded in 4 KiB chunks, as a serial port delivers it. ST7580: status
+//! messages, requests, confirms, indications with 16-250 byte payloads,
+//! ACKs, 1 % garbage bytes. ST7570: both directions of a MAC Server
+//! (status messages, M_Data indications and requests of 1-242 bytes,
+//! confirms, synchronization, alarm, intelligent synchronization and
+//! repeater call frames, MIB reads and writes) switched by MIB 00A1h
+//! writes to a PHY Monitor and back (spy indications, P_Data
+//! indications), ACKs, garbage bytes. Each figure is the median of 7 runs
+//! after one warm-up run. Allocations are counted by a counting global
+//! allocator around the decoding loop only, divided by the frames decoded.
+
+mod st7570;
 
 use plm_core::decode::Decoder;
 use plm_core::link::{Dialect, Element, LocalFrame, Source, StreamDecoder};
@@ -46,6 +53,9 @@ impl Rng {
     }
     fn below(&mut self, n: u64) -> u64 {
         self.next() % n
+    }
+    fn bytes(&mut self, n: usize) -> Vec<u8> {
+        (0..n).map(|_| self.below(256) as u8).collect()
     }
 }
 
@@ -99,11 +109,11 @@ fn measure(name: &str, input: &[u8], frames: usize, mut run: impl FnMut(&[u8]) -
     );
 }
 
-fn main() {
-    let (input, frames) = capture(4 << 20);
-    println!("stream decoder, ST7580, 4 KiB chunks, median of 7 runs:");
-    measure("link::StreamDecoder (elements)", &input, frames, |bytes| {
-        let mut d = StreamDecoder::new(Dialect::St7580, Source::Modem);
+/// The stream decoder and the named-field decoder over `input`.
+fn measure_both(chip: &str, dialect: Dialect, source: Source, input: &[u8], frames: usize) {
+    println!("stream decoder, {chip}, 4 KiB chunks, median of 7 runs:");
+    measure("link::StreamDecoder (elements)", input, frames, |bytes| {
+        let mut d = StreamDecoder::new(dialect, source);
         let mut n = 0;
         for chunk in bytes.chunks(4096) {
             d.push(chunk);
@@ -129,8 +139,8 @@ fn main() {
         }
         n
     });
-    measure("decode::Decoder (named fields)", &input, frames, |bytes| {
-        let mut d = Decoder::new(Dialect::St7580, Source::Modem);
+    measure("decode::Decoder (named fields)", input, frames, |bytes| {
+        let mut d = Decoder::new(dialect, source);
         let mut n = 0;
         for chunk in bytes.chunks(4096) {
             d.push(chunk);
@@ -144,4 +154,11 @@ fn main() {
         }
         n
     });
+}
+
+fn main() {
+    let (input, frames) = capture(4 << 20);
+    measure_both("ST7580", Dialect::St7580, Source::Modem, &input, frames);
+    let (input, frames) = st7570::capture(4 << 20, &mut Rng(0x5EED));
+    measure_both("ST7570", Dialect::St7570, Source::Any, &input, frames);
 }
