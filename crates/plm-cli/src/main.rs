@@ -25,7 +25,7 @@ enum Command {
     /// Decode host-interface bytes into JSON Lines, one object per frame,
     /// ACK, NAK, status message or run of garbage; with --board, a
     /// controller board's USART, one object per application frame or run
-    /// of garbage.
+    /// of garbage; with --chip st7570 --line, a frame from the power line.
     Decode(DecodeArgs),
     /// Serve a simulated modem as an RFC 2217 (Telnet COM-PORT-OPTION)
     /// serial port: RTS drives T_REQ, SET-BAUDRATE the BR pins.
@@ -80,6 +80,11 @@ struct DecodeArgs {
     /// until they say otherwise.
     #[arg(long, value_enum)]
     layer: Option<LayerArg>,
+    /// The bytes are from the ST7570's power line, not its host interface:
+    /// one long MAC frame, its 38-byte subframes or its 45-byte PHY frames
+    /// (IEC 61334-5-1), printed as one JSON object.
+    #[arg(long, conflicts_with_all = ["board", "from", "mib_index", "layer"])]
+    line: bool,
     /// Hex bytes (spaces, dots, colons allowed); read from stdin if absent.
     hex: Vec<String>,
 }
@@ -217,6 +222,14 @@ fn decode(args: DecodeArgs) -> Result<(), String> {
         writeln!(out, "{line}").map_err(|e| format!("cannot write: {e}"))
     };
     let dialect = match args.chip {
+        Some(Chip::St7580) if args.line => {
+            return Err("--line is for the ST7570's power line frames: add --chip st7570".into())
+        }
+        Some(Chip::St7570) if args.line => {
+            let frame = plm_core::decode::decode_line(&bytes);
+            print(serde_json::to_string(&frame))?;
+            return out.flush().map_err(|e| format!("cannot write: {e}"));
+        }
         Some(Chip::St7580) => Dialect::St7580,
         Some(Chip::St7570) => Dialect::St7570,
         None => {

@@ -13,10 +13,14 @@
 //! once from the dialect ([`Chip::new`]): [`st7580`] (MIB_ReadConfirm named
 //! by the request before it; DL payloads carrying application frames)
 //! and [`st7570`] (the access layer the frames are read in, named in
-//! `layer`; MIB frames that carry their index).
+//! `layer`; MIB frames that carry their index). Frames from the ST7570's
+//! power line itself are [`decode_line`]'s ([`LineDecoded`]).
 
 mod st7570;
+mod st7570_line;
 mod st7580;
+
+pub use st7570_line::{decode_line, LineDecoded};
 
 use crate::field::{Field, Value};
 use crate::hex;

@@ -188,7 +188,7 @@ impl Context {
 /// The named values of `data` under `layout`; a 12-bit field is a MAC
 /// address (Table 5), and one of Table 6's groups is also named, under
 /// `<field>_group` (`"da": 4095, "da_group": "BROADCAST"`).
-fn put_fields(map: &mut Object, layout: &'static [Field], data: &[u8]) {
+pub(super) fn put_fields(map: &mut Object, layout: &'static [Field], data: &[u8]) {
     for (field, v) in crate::mib::describe(layout, data) {
         let group = match (&v, field.max) {
             (Value::Uint(a), 0xFFF) => u16::try_from(*a).ok().and_then(Group::of),

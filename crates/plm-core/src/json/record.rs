@@ -66,6 +66,16 @@ impl Scalar for u16 {
     }
 }
 
+impl Scalar for u32 {
+    const WHAT: &'static str = "a whole number from 0 to 4294967295";
+    fn to_json(&self) -> Json {
+        Json::from(*self)
+    }
+    fn from_json(v: &Json) -> Option<Self> {
+        v.as_i64()?.try_into().ok()
+    }
+}
+
 impl Scalar for Object {
     const WHAT: &'static str = "an object";
     fn to_json(&self) -> Json {
