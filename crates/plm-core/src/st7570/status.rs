@@ -356,8 +356,9 @@ impl Status {
     }
 }
 
-/// The named values of a status message's three bytes, by its row; the
-/// stray bits appear as `stray_byte_1..3` when set.
+/// The named values of a status message's three bytes, by its row. Bits
+/// set where the row has a fixed 0 are not among them: they are
+/// [`Status::stray`] (the decoder shows them as `stray_byte_1..3`).
 pub fn describe(data: &[u8]) -> alloc::vec::Vec<(&'static Field, Value)> {
     let Some(first) = data.first() else {
         return alloc::vec::Vec::new();
