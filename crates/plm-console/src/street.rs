@@ -8,7 +8,7 @@
 
 mod campaign;
 
-pub use campaign::{campaign_of, Campaign};
+pub use campaign::Campaign;
 
 use crate::session::{Budget, Pacer};
 use crate::transport::{LinkState, Transport};

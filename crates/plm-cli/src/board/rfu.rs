@@ -24,12 +24,6 @@ fn state_path(args: &RfuArgs) -> PathBuf {
     })
 }
 
-/// The campaign number of an image: from its CRC-32, so that the same
-/// image gets the same number (a board holding its segments resumes).
-pub fn campaign_of(crc: u32) -> u8 {
-    (crc % 255) as u8 + 1
-}
-
 /// Writes `bytes` to `path` so that a crash leaves the old file or the
 /// new one, never half of one: a temporary file beside it, synced, then
 /// renamed over it.
@@ -58,7 +52,7 @@ pub fn write_image(args: &ImageArgs) -> Result<u8, Failure> {
         info.version,
         info.size,
         info.crc,
-        campaign_of(info.crc)
+        info.campaign()
     );
     Ok(exit::OK)
 }
@@ -159,7 +153,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
                 gap: r.gap_ms * MS,
                 ..UpdateConfig::default()
             };
-            Update::new(campaign_of(info.crc), info.version, bytes, &targets, config)
+            Update::new(info.campaign(), info.version, bytes, &targets, config)
                 .map_err(|why| Failure::input(format!("cannot update: {why}")))?
         }
     };
@@ -385,14 +379,6 @@ fn duration_words(secs: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn campaigns_are_1_to_255() {
-        assert_eq!(campaign_of(0), 1);
-        assert_eq!(campaign_of(254), 255);
-        assert_eq!(campaign_of(255), 1);
-        assert_eq!(campaign_of(u32::MAX), (u32::MAX % 255) as u8 + 1);
-    }
 
     #[test]
     fn durations_in_words() {

@@ -25,12 +25,6 @@ pub struct Campaign {
     sweep_was_on: bool,
 }
 
-/// The campaign number of an image: from its CRC-32, so that the same
-/// image sent again resumes on boards that still hold its segments.
-pub fn campaign_of(crc: u32) -> u8 {
-    (crc % 255) as u8 + 1
-}
-
 impl StreetSession {
     /// The campaign, if one was started.
     pub fn campaign(&self) -> Option<&Campaign> {
@@ -42,7 +36,7 @@ impl StreetSession {
     pub fn start_update(&mut self, image: Vec<u8>, targets: &[Address]) -> Result<(), String> {
         let info = image::check(&image)?;
         let u = Update::new(
-            campaign_of(info.crc),
+            info.campaign(),
             info.version,
             image,
             targets,

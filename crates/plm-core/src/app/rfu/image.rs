@@ -51,6 +51,15 @@ pub struct Image {
     pub crc: u32,
 }
 
+impl Image {
+    /// The campaign number to send it under: from its CRC-32, so that the
+    /// same image gets the same number from the console and from
+    /// `plm board rfu` (a board holding its segments resumes).
+    pub fn campaign(&self) -> u8 {
+        (self.crc % 255) as u8 + 1
+    }
+}
+
 fn word(image: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([image[at], image[at + 1], image[at + 2], image[at + 3]])
 }
@@ -165,6 +174,21 @@ mod tests {
         assert_eq!(info.version, V);
         assert_eq!(info.size, 4_000);
         assert_eq!(info.crc, image_crc(&image));
+    }
+
+    #[test]
+    fn campaigns_are_1_to_255() {
+        let with = |crc| {
+            Image {
+                crc,
+                ..check(&good(4_000)).unwrap()
+            }
+            .campaign()
+        };
+        assert_eq!(with(0), 1);
+        assert_eq!(with(254), 255);
+        assert_eq!(with(255), 1);
+        assert_eq!(with(u32::MAX), (u32::MAX % 255) as u8 + 1);
     }
 
     #[test]
