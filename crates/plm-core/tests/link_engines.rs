@@ -4,7 +4,10 @@
 
 mod harness;
 
-use harness::{faults, ping_responder, Dir, Fault, Part, Sim, PING_CNF, PING_REQ};
+use harness::{
+    check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, ping_responder, Dir,
+    Fault, Part, Sim, PING_CNF, PING_REQ,
+};
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Transmit};
 use plm_core::link::{
@@ -42,22 +45,6 @@ fn indication() -> LocalFrame {
 
 fn emit(f: &LocalFrame) -> Vec<u8> {
     f.emit(Dialect::St7580).unwrap()
-}
-
-fn is_retry(e: &Event) -> bool {
-    matches!(e, Event::Retry { .. })
-}
-
-fn is_failed(e: &Event) -> bool {
-    matches!(e, Event::Failed(..))
-}
-
-fn is_delivered(e: &Event) -> bool {
-    matches!(e, Event::Delivered(_))
-}
-
-fn is_repeat(e: &Event) -> bool {
-    matches!(e, Event::Repeat(_))
 }
 
 fn statuses_sent(sim: &Sim) -> Vec<Instant> {
@@ -1102,37 +1089,9 @@ proptest! {
         pings in prop::collection::vec((0u32..120_000, prop::collection::vec(any::<u8>(), 0..24)), 1..7),
     ) {
         let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
-        sim.horizon = 120_000_000;
-        sim.inject_with(Dir::HostToDev, None, faults(seed, drop_pm, corrupt_pm));
-        sim.inject_with(Dir::DevToHost, None, faults(seed.rotate_left(32), drop_pm, corrupt_pm));
-        let mut payloads = Vec::new();
-        let mut tickets = Vec::new();
-        for (i, (gap, data)) in pings.into_iter().enumerate() {
-            sim.run_until(sim.now + gap as u64);
-            let mut d = vec![i as u8];
-            d.extend(data);
-            tickets.push(sim.submit(LocalFrame::new(PING_REQ, d.clone())));
-            payloads.push(d);
-        }
-        sim.run_to_idle();
-
-        // Each ticket: Delivered or Failed, exactly once.
-        for t in &tickets {
-            let ends = sim.host_events_where(|e| matches!(e, Event::Delivered(x) | Event::Failed(x, _) if x == t));
-            prop_assert_eq!(ends.len(), 1, "{:?}: {:?}", t, ends);
-        }
-        prop_assert_eq!(sim.host.pending(), 0);
-        // The device accepted only what was submitted, in order (a later
-        // ping is sent only once the earlier one is over).
-        let mut last = 0usize;
-        for r in sim.requests() {
-            prop_assert_eq!(r.code, PING_REQ);
-            let i = payloads.iter().position(|p| *p == r.data);
-            prop_assert!(i.is_some(), "accepted a payload never submitted: {:02x?}", r.data);
-            let i = i.unwrap();
-            prop_assert!(i >= last, "request {} accepted after {}", i, last);
-            last = i;
-        }
+        let (payloads, tickets) =
+            lossy_requests(&mut sim, (seed, drop_pm, corrupt_pm), PING_REQ, pings);
+        check_lossy(&sim, PING_REQ, &payloads, &tickets)?;
         // The host accepted only confirms the device sent.
         for f in sim.host_frames() {
             prop_assert_eq!(f.code, PING_CNF);

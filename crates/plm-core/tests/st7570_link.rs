@@ -7,7 +7,10 @@
 
 mod harness;
 
-use harness::{faults, Dir, Fault, Part, Responder, Sim};
+use harness::{
+    check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, Dir, Fault, Part,
+    Responder, Sim,
+};
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, LinkError, Transmit};
 use plm_core::link::{
@@ -85,22 +88,6 @@ fn indication(n: u8) -> LocalFrame {
 
 fn emit(f: &LocalFrame) -> Vec<u8> {
     f.emit(ST7570).unwrap()
-}
-
-fn is_retry(e: &Event) -> bool {
-    matches!(e, Event::Retry { .. })
-}
-
-fn is_failed(e: &Event) -> bool {
-    matches!(e, Event::Failed(..))
-}
-
-fn is_delivered(e: &Event) -> bool {
-    matches!(e, Event::Delivered(_))
-}
-
-fn is_repeat(e: &Event) -> bool {
-    matches!(e, Event::Repeat(_))
 }
 
 fn outcome(e: &Event) -> bool {
@@ -1026,35 +1013,10 @@ proptest! {
         reqs in prop::collection::vec((0u32..120_000, prop::collection::vec(any::<u8>(), 0..24)), 1..7),
     ) {
         let mut sim = sim_at(baud);
-        sim.horizon = 120_000_000;
-        sim.inject_with(Dir::HostToDev, None, faults(seed, drop_pm, corrupt_pm));
-        sim.inject_with(Dir::DevToHost, None, faults(seed.rotate_left(32), drop_pm, corrupt_pm));
-        let mut payloads = Vec::new();
-        let mut tickets = Vec::new();
-        for (i, (gap, data)) in reqs.into_iter().enumerate() {
-            sim.run_until(sim.now + gap as u64);
-            let mut d = vec![i as u8];
-            d.extend(data);
-            tickets.push(sim.submit(LocalFrame::new(READ_DB_REQ, d.clone())));
-            payloads.push(d);
-        }
-        sim.run_to_idle();
-
-        for t in &tickets {
-            let ends = sim.host_events_where(|e| matches!(e, Event::Delivered(x) | Event::Failed(x, _) if x == t));
-            prop_assert_eq!(ends.len(), 1, "{:?}: {:?}", t, ends);
-        }
-        prop_assert_eq!(sim.host.pending(), 0);
+        let (payloads, tickets) =
+            lossy_requests(&mut sim, (seed, drop_pm, corrupt_pm), READ_DB_REQ, reqs);
+        check_lossy(&sim, READ_DB_REQ, &payloads, &tickets)?;
         prop_assert!(sim.dev.is_idle());
-        let mut last = 0usize;
-        for r in sim.requests() {
-            prop_assert_eq!(r.code, READ_DB_REQ);
-            let i = payloads.iter().position(|p| *p == r.data);
-            prop_assert!(i.is_some(), "accepted a payload never submitted: {:02x?}", r.data);
-            let i = i.unwrap();
-            prop_assert!(i >= last, "request {} accepted after {}", i, last);
-            last = i;
-        }
         // The host accepted only confirms the device sent, and no device
         // frame was sent more than twice.
         for f in sim.host_frames() {

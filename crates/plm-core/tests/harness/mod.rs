@@ -695,3 +695,87 @@ pub fn faults(seed: u64, drop_pm: u64, corrupt_pm: u64) -> impl FnMut(&ByteCtx) 
         }
     }
 }
+
+/// The host's events by kind.
+pub fn is_retry(e: &Event) -> bool {
+    matches!(e, Event::Retry { .. })
+}
+
+/// See [`is_retry`].
+pub fn is_failed(e: &Event) -> bool {
+    matches!(e, Event::Failed(..))
+}
+
+/// See [`is_retry`].
+pub fn is_delivered(e: &Event) -> bool {
+    matches!(e, Event::Delivered(_))
+}
+
+/// See [`is_retry`].
+pub fn is_repeat(e: &Event) -> bool {
+    matches!(e, Event::Repeat(_))
+}
+
+/// Requests of `code` through a line with the [`faults`] of `seed`,
+/// `drop_pm` and `corrupt_pm` both ways: each `(gap, data)` waits `gap` µs,
+/// then goes with its number first (so every payload differs); runs to
+/// idle. The payloads sent and their tickets.
+pub fn lossy_requests(
+    sim: &mut Sim,
+    (seed, drop_pm, corrupt_pm): (u64, u64, u64),
+    code: u8,
+    reqs: Vec<(u32, Vec<u8>)>,
+) -> (Vec<Vec<u8>>, Vec<Ticket>) {
+    sim.horizon = 120_000_000;
+    sim.inject_with(Dir::HostToDev, None, faults(seed, drop_pm, corrupt_pm));
+    sim.inject_with(
+        Dir::DevToHost,
+        None,
+        faults(seed.rotate_left(32), drop_pm, corrupt_pm),
+    );
+    let mut payloads = Vec::new();
+    let mut tickets = Vec::new();
+    for (i, (gap, data)) in reqs.into_iter().enumerate() {
+        sim.run_until(sim.now + gap as u64);
+        let mut d = vec![i as u8];
+        d.extend(data);
+        tickets.push(sim.submit(LocalFrame::new(code, d.clone())));
+        payloads.push(d);
+    }
+    sim.run_to_idle();
+    (payloads, tickets)
+}
+
+/// What every run of [`lossy_requests`] must show, whatever the line did:
+/// each ticket ended exactly once, nothing is pending, and the device
+/// accepted only requests of `code` that were submitted, in order (a
+/// later one goes only once the earlier one is over).
+pub fn check_lossy(
+    sim: &Sim,
+    code: u8,
+    payloads: &[Vec<u8>],
+    tickets: &[Ticket],
+) -> Result<(), proptest::test_runner::TestCaseError> {
+    use proptest::{prop_assert, prop_assert_eq};
+    for t in tickets {
+        let ends = sim.host_events_where(
+            |e| matches!(e, Event::Delivered(x) | Event::Failed(x, _) if x == t),
+        );
+        prop_assert_eq!(ends.len(), 1, "{:?}: {:?}", t, ends);
+    }
+    prop_assert_eq!(sim.host.pending(), 0);
+    let mut last = 0usize;
+    for r in sim.requests() {
+        prop_assert_eq!(r.code, code);
+        let i = payloads.iter().position(|p| *p == r.data);
+        prop_assert!(
+            i.is_some(),
+            "accepted a payload never submitted: {:02x?}",
+            r.data
+        );
+        let i = i.unwrap();
+        prop_assert!(i >= last, "request {} accepted after {}", i, last);
+        last = i;
+    }
+    Ok(())
+}
