@@ -1147,3 +1147,171 @@ fn queued_frames_go_one_after_the_other() {
         .host_events_where(|e| is_retry(e) || is_failed(e) || is_repeat(e))
         .is_empty());
 }
+
+// ---- 10. T_REQ released before the STX; frames ready during the wait -------
+
+/// Everything the device wrote by now, in order.
+fn dev_written(dev: &mut DeviceEngine) -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    while let Some(t) = dev.poll_transmit() {
+        match t {
+            Transmit::Bytes(b) => out.push(b),
+            Transmit::TReq { .. } => panic!("the device has no T_REQ output"),
+        }
+    }
+    out
+}
+
+const STATUS_IDLE: [u8; 2] = [0x3F, 0x00];
+
+#[test]
+fn t_req_released_before_the_stx_ends_the_wait_and_a_new_edge_is_answered_at_once() {
+    let mut dev = DeviceEngine::new(Dialect::St7580, BAUD);
+    dev.set_treq(0, true);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+    let status_end = wire_time(2, BAUD);
+    // Waiting for the host's STX until T_SR after the status.
+    assert_eq!(dev.poll_timeout(), Some(status_end + T_SR + 1));
+    // UM0932 3.2.8: the host gives up this frame and releases T_REQ
+    // before its STX: the wait is over, nothing is left to time.
+    let released = status_end + 100;
+    dev.set_treq(released, false);
+    assert_eq!(dev.poll_timeout(), None);
+    assert!(dev.is_idle());
+    // Pulled low again microseconds later: answered like the first edge,
+    // at once, not T_SR later.
+    dev.set_treq(released + 5, true);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+    // And that status opens a wait of its own: a frame whose STX comes
+    // within T_SR of it is taken.
+    let req = emit(&ping());
+    dev.handle_rx(released + 5 + status_end, &req[..1]);
+    dev.set_treq(released + 5 + status_end, false);
+    let mut t = released + 5 + status_end;
+    for &byte in &req[1..] {
+        t += b(BAUD);
+        dev.handle_rx(t, &[byte]);
+    }
+    assert_eq!(dev_written(&mut dev), vec![vec![ACK]]);
+    let mut requests = Vec::new();
+    while let Some(e) = dev.poll_event() {
+        if let DeviceEvent::Request(f) = e {
+            requests.push(f);
+        }
+    }
+    assert_eq!(requests, vec![ping()]);
+}
+
+#[test]
+fn a_frame_ready_during_the_wait_goes_out_when_t_req_is_released_before_the_next_status() {
+    let mut dev = DeviceEngine::new(Dialect::St7580, BAUD);
+    dev.set_treq(0, true);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+    // The confirm of the previous request becomes ready while the modem
+    // waits for the host's frame: held while the wait lasts.
+    let cnf = indication();
+    dev.submit(MS, cnf.clone());
+    assert!(dev_written(&mut dev).is_empty());
+    // T_REQ released and asserted again at once (the host read "not now"
+    // in the status): the confirm goes out as the wait ends, before the
+    // status of the new edge.
+    dev.set_treq(2 * MS, false);
+    dev.set_treq(2 * MS + 3, true);
+    assert_eq!(dev_written(&mut dev), vec![emit(&cnf)]);
+    // The status follows the confirm's exchange (here the host's ACK).
+    let cnf_end = 2 * MS + wire_time(emit(&cnf).len(), BAUD);
+    dev.handle_rx(cnf_end + b(BAUD), &[ACK]);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+}
+
+#[test]
+fn a_frame_ready_while_the_host_frame_comes_in_goes_before_the_status_of_the_next_t_req() {
+    let b1 = b(BAUD);
+    let mut dev = DeviceEngine::new(Dialect::St7580, BAUD);
+    dev.set_treq(0, true);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+    let mut t = wire_time(2, BAUD);
+    let req = emit(&ping());
+    dev.handle_rx(t, &req[..1]);
+    dev.set_treq(t, false);
+    // Mid-frame: the previous request's confirm becomes ready, and the
+    // host already pulls T_REQ for its next request.
+    dev.submit(t + 1, indication());
+    dev.set_treq(t + 2, true);
+    for &byte in &req[1..] {
+        t += b1;
+        dev.handle_rx(t, &[byte]);
+    }
+    // ACK, then the confirm, and only then the new status.
+    assert_eq!(dev_written(&mut dev), vec![vec![ACK], emit(&indication())]);
+    let cnf_end = t + wire_time(1 + emit(&indication()).len(), BAUD);
+    dev.handle_rx(cnf_end + b1, &[ACK]);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+}
+
+#[test]
+fn t_req_still_pending_is_served_before_frames_queued_outside_a_wait() {
+    // The old rule stands where no host frame was awaited: a frame queued
+    // while another is on the wire waits behind a pending T_REQ.
+    let mut dev = DeviceEngine::new(Dialect::St7580, BAUD);
+    dev.submit(0, indication());
+    assert_eq!(dev_written(&mut dev), vec![emit(&indication())]);
+    dev.set_treq(10, true);
+    dev.submit(20, ping());
+    let end = wire_time(emit(&indication()).len(), BAUD);
+    dev.handle_rx(end + b(BAUD), &[ACK]);
+    assert_eq!(dev_written(&mut dev), vec![STATUS_IDLE.to_vec()]);
+}
+
+#[test]
+fn host_retries_a_not_now_status_with_a_new_edge_and_takes_the_modem_frame_first() {
+    let b1 = b(BAUD);
+    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
+    // Bits 1-2 of the status: transmission or reception in progress.
+    sim.host.set_not_now(0b0000_0110);
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x02]));
+    let req = ping();
+    let ticket = sim.submit(req.clone());
+    sim.run_until(MS);
+    // Each busy status: T_REQ released before any byte and pulled low
+    // again at once, each edge answered within a status' wire time.
+    let statuses = statuses_sent(&sim);
+    assert!(statuses.len() >= 3, "{statuses:?}");
+    let edges: Vec<Instant> = sim
+        .treq
+        .iter()
+        .filter(|(_, a)| *a)
+        .map(|(t, _)| *t)
+        .collect();
+    for (edge, status) in edges.iter().zip(&statuses) {
+        assert!(
+            status - edge <= b1,
+            "status at {status} for the edge at {edge}"
+        );
+    }
+    assert!(sim.wire(Dir::HostToDev).next().is_none(), "no frame yet");
+    // A modem frame becomes ready during a wait: it comes before the next
+    // status, and the host takes it.
+    let ind = indication();
+    sim.dev_submit(ind.clone());
+    sim.run_until(2 * MS);
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0]));
+    sim.run_to_idle();
+    assert_eq!(sim.host_frames()[0], ind);
+    assert_eq!(sim.requests(), vec![req.clone()]);
+    assert_eq!(sim.host_events_where(is_delivered).len(), 1);
+    assert!(
+        sim.host_events_where(|e| *e == Event::Delivered(ticket))
+            .len()
+            == 1
+    );
+    assert!(sim
+        .host_events_where(|e| is_retry(e) || is_failed(e) || is_repeat(e))
+        .is_empty());
+    // The indication went out between two statuses, not after a T_SR.
+    let ind_start = sim.frame_start(Dir::DevToHost, 0);
+    assert!(ind_start < 2 * MS + wire_time(4, BAUD), "{ind_start}");
+    assert!(sim.host_frames().contains(&confirm(&req)));
+}

@@ -4,7 +4,11 @@
 //! Rules implemented (UM0932 3.2.5-3.2.9; ST7570 UM 5.2.2-5.2.3, where
 //! the chips differ the [`Dialect`] says how):
 //! - on T_REQ low, answer with the status message as soon as not busy;
-//!   accept the host's frame only if its STX comes within T_SR;
+//!   accept the host's frame only if its STX comes within T_SR; T_REQ
+//!   released before that STX ends the wait at once, and a new falling
+//!   edge is answered like the first;
+//! - send a frame that became ready while the host's frame was awaited as
+//!   soon as that wait ends, before the status of a later T_REQ;
 //! - ACK a frame with right length and checksum, NAK any other;
 //! - send frames with STX 02h unprompted (the modem is master);
 //! - repeat a frame once as [`Dialect::modem_reaction`] says (ST7580: on
@@ -83,6 +87,12 @@ pub struct DeviceEngine {
     /// The host's frame started within T_SR of the status message: the
     /// frame being received is one the modem takes.
     host_frame_open: bool,
+    /// Frames at the head of the queue that became ready while the host's
+    /// frame was awaited: they go out as soon as that wait ends, before
+    /// the status message of a later T_REQ (UM0932 3.2.5: the modem is
+    /// master; a confirm held back further is paired by the host with the
+    /// wrong request).
+    ready_first: usize,
     transmits: VecDeque<Transmit>,
     events: VecDeque<DeviceEvent>,
     /// When the UART will have sent every byte written so far. Timeouts
@@ -108,6 +118,7 @@ impl DeviceEngine {
             treq: false,
             treq_served: false,
             host_frame_open: false,
+            ready_first: 0,
             transmits: VecDeque::new(),
             events: VecDeque::new(),
             tx_clock: TxClock::default(),
@@ -163,6 +174,7 @@ impl DeviceEngine {
         self.tic = Self::reset_tic(self.dialect);
         self.treq_served = self.treq;
         self.host_frame_open = false;
+        self.ready_first = 0;
     }
 
     /// Queues a frame for the host (confirms, errors, indications). A frame
@@ -173,6 +185,9 @@ impl DeviceEngine {
             return;
         }
         self.queue.push_back(frame);
+        if matches!(self.state, State::AwaitHostFrame { .. }) || self.host_frame_open {
+            self.ready_first = self.queue.len();
+        }
         self.advance(now);
     }
 
@@ -185,6 +200,18 @@ impl DeviceEngine {
             // ST7570 within T_POLL, UM 5.2.2).
             if let State::AwaitHostFrame { .. } = self.state {
                 self.state = State::Idle;
+            }
+        }
+        if !asserted && self.treq {
+            // UM0932 3.2.8: the host keeps T_REQ low until its frame's STX
+            // is out. Released before the first byte, the host has given
+            // up this frame ("not now" from the status, 3.2.8): the wait
+            // ends, and the modem, master again (3.2.5), sends what became
+            // ready meanwhile before it answers a later falling edge.
+            if let State::AwaitHostFrame { .. } = self.state {
+                if !self.rx.busy() {
+                    self.state = State::Idle;
+                }
             }
         }
         self.treq = asserted;
@@ -367,6 +394,14 @@ impl DeviceEngine {
         if self.state != State::Idle || self.rx.busy() {
             return;
         }
+        if self.ready_first > 0 {
+            self.ready_first -= 1;
+            if let Some(frame) = self.queue.pop_front() {
+                self.send_queued(now, frame);
+                return;
+            }
+            self.ready_first = 0;
+        }
         if self.treq && !self.treq_served {
             self.treq_served = true;
             let status = Element::Status(self.status);
@@ -377,12 +412,17 @@ impl DeviceEngine {
             return;
         }
         if let Some(frame) = self.queue.pop_front() {
-            let end = self.send_frame(now, &frame);
-            self.state = State::AwaitAck {
-                frame,
-                end,
-                deadline: end + self.timeouts.t_ack,
-            };
+            self.send_queued(now, frame);
         }
+    }
+
+    /// Sends a frame of the queue and waits for its answer.
+    fn send_queued(&mut self, now: Instant, frame: LocalFrame) {
+        let end = self.send_frame(now, &frame);
+        self.state = State::AwaitAck {
+            frame,
+            end,
+            deadline: end + self.timeouts.t_ack,
+        };
     }
 }

@@ -170,6 +170,9 @@ pub struct HostEngine {
     /// the repeat (UM0932 3.2.7, ST7570 UM 5.2.2).
     last_accepted: Option<Accepted>,
     last_status: Option<StatusMessage>,
+    /// Bits of the status message's first data byte that mean "not now"
+    /// (see [`HostEngine::set_not_now`]); 0: any status is permission.
+    not_now: u8,
     /// When the UART will have sent every byte written so far: T_ACK runs
     /// from the frame's last byte on the wire (UM0932 3.2.8), which is later
     /// than its own length says when an ACK was written just before it.
@@ -191,6 +194,7 @@ impl HostEngine {
             events: VecDeque::new(),
             last_accepted: None,
             last_status: None,
+            not_now: 0,
             tx_clock: TxClock::default(),
         }
     }
@@ -203,6 +207,19 @@ impl HostEngine {
     /// Changes the timeouts (after a MIB 09h write was confirmed) or baud.
     pub fn set_config(&mut self, config: HostConfig) {
         self.config = config;
+    }
+
+    /// Takes a status message whose first data byte has one of the `mask`
+    /// bits set as "not now" (UM0932 3.2.8: the status "confirms or not"
+    /// the data channel availability): T_REQ is released before any byte
+    /// of the frame, which ends the modem's wait, and pulled low again at
+    /// once, a new falling edge the modem answers like the first. A frame
+    /// the modem had ready meanwhile comes first (the wait for the status
+    /// restarts on every modem byte). Not an attempt: the frame was not
+    /// sent. 0 (the default): any status is permission, see
+    /// docs/protocol-notes.md "Status message availability".
+    pub fn set_not_now(&mut self, mask: u8) {
+        self.not_now = mask;
     }
 
     /// The last status message received.
@@ -368,7 +385,16 @@ impl HostEngine {
             Element::Status(s) => {
                 self.last_status = Some(s);
                 if let State::AwaitStatus { .. } = self.state {
-                    self.send_current(now);
+                    let not_now = s.data().first().is_some_and(|b| b & self.not_now != 0);
+                    if not_now && self.current.is_some() {
+                        self.transmits.push_back(Transmit::TReq { asserted: false });
+                        self.transmits.push_back(Transmit::TReq { asserted: true });
+                        self.state = State::AwaitStatus {
+                            deadline: now + self.dialect.status_wait(&self.config.timeouts),
+                        };
+                    } else {
+                        self.send_current(now);
+                    }
                 }
             }
             Element::Ack => {
