@@ -340,6 +340,8 @@ pub enum Action {
     SetBaud(u32),
     /// Set RTS (true = ON, the line asserted).
     SetRts(bool),
+    /// Set DTR (true = ON, the line asserted).
+    SetDtr(bool),
     /// Drop data received from the port and not yet sent to the client.
     PurgeReceive,
     /// Drop data from the client not yet written to the port.
@@ -548,8 +550,9 @@ impl Server {
                     // BREAK is not simulated: it stays off.
                     BREAK_QUERY..=BREAK_OFF => BREAK_OFF,
                     DTR_QUERY..=DTR_OFF => {
-                        if value != DTR_QUERY {
+                        if value != DTR_QUERY && self.dtr != (value == DTR_ON) {
                             self.dtr = value == DTR_ON;
+                            actions.push(Action::SetDtr(self.dtr));
                         }
                         if self.dtr {
                             DTR_ON
@@ -867,9 +870,10 @@ mod tests {
         assert_eq!(ask(10), (sb(105, &[11]), vec![]));
         assert_eq!(ask(12), (sb(105, &[12]), vec![Action::SetRts(false)]));
         assert_eq!(ask(7), (sb(105, &[9]), vec![]));
+        assert_eq!(ask(8), (sb(105, &[8]), vec![Action::SetDtr(true)]));
         assert_eq!(ask(8), (sb(105, &[8]), vec![]));
         assert_eq!(ask(7), (sb(105, &[8]), vec![]));
-        assert_eq!(ask(9), (sb(105, &[9]), vec![]));
+        assert_eq!(ask(9), (sb(105, &[9]), vec![Action::SetDtr(false)]));
         for (value, answer) in [
             (0, 1),
             (1, 1),

@@ -15,15 +15,20 @@
 //! | data                                 | host UART TX -> modem RX   |
 //! | SET-BAUDRATE 9600/19200/38400/57600  | BR pins (`Sim::set_baud`)  |
 //! | SET-CONTROL RTS ON / OFF             | T_REQ asserted / released  |
+//! | SET-CONTROL DTR ON / OFF             | RESETN held low / released |
 //! | data to the client                   | modem UART TX -> host RX   |
 //!
 //! The modems are powered on (simulated time 0) when the first client
 //! connects, so that it sees the BIO_ResetIndication; later clients find
 //! them running. One client at a time: another one is told so and closed.
-//! When the client goes, T_REQ is released and the simulation goes on.
+//! When the client goes, T_REQ and DTR are released and the simulation
+//! goes on. DTR is wired to RESETN, as on many USB-UART boards: a client
+//! that asserts it holds the modem off (a DTR pulse resets it, factory
+//! MIB and BIO_ResetIndication); a client that never touches DTR finds the
+//! modem running (the line starts released).
 
 use crate::rfc2217::{self, Action};
-use plm_sim::{Attach, Sim, SimConfig};
+use plm_sim::{Attach, Fault, Sim, SimConfig};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -171,8 +176,9 @@ pub fn run(opts: Options) -> Result<(), String> {
             println!("plm sim: client {} disconnected ({why})", c.peer);
             client = None;
             advance(&mut sim, start);
-            // The host is gone: T_REQ is released (pulled up).
+            // The host is gone: T_REQ and DTR are released (pulled up).
             sim.set_treq(false);
+            sim.inject(Fault::Resetn(false));
         }
     }
     if let Some(c) = client {
@@ -293,6 +299,9 @@ impl Client {
                 Action::Write(data) => sim.write(&data),
                 Action::SetBaud(baud) => sim.set_baud(baud),
                 Action::SetRts(on) => sim.set_treq(on),
+                // DTR wired to RESETN, as on many USB-UART boards: asserted
+                // holds the modem in reset, released boots it.
+                Action::SetDtr(on) => sim.inject(Fault::Resetn(on)),
                 Action::PurgeReceive => {
                     self.held.clear();
                     sim.host_read();

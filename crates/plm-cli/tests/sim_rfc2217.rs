@@ -284,3 +284,61 @@ fn a_remote_address_needs_allow_remote() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--allow-remote"), "{err}");
 }
+
+/// One request of the host: ACKed, then its confirm.
+fn ask(c: &mut Client, frame: &[u8]) -> LocalFrame {
+    c.request(frame);
+    assert_eq!(c.next_element(), Element::Ack, "ACK of {frame:02X?}");
+    c.next_frame()
+}
+
+#[test]
+fn a_dtr_pulse_resets_the_modem_to_its_factory_mib() {
+    let mut server = Server::start(&["--chip", "st7580", "--listen", "127.0.0.1:0"]);
+    let mut c = Client::connect(&server.addr);
+    server.line_containing("connected");
+    c.send(&[IAC, WILL, COM_PORT]);
+    c.expect_telnet("DO COM-PORT-OPTION", |t| {
+        *t == Telnet::Negotiation(DO, COM_PORT)
+    });
+    c.set_rts(false);
+    assert_eq!(c.next_frame().code, 0x3E, "BIO_ResetIndication at power-on");
+
+    // The host configures its modem: MIB 00h (Modem_Config, factory 11h)
+    // to 10h.
+    let write = frame(0x08, &[0x00, 0x10]);
+    assert_eq!(ask(&mut c, &write).code, 0x09, "MIB_WriteConfirm");
+    let read = frame(0x0C, &[0x00]);
+    assert_eq!(ask(&mut c, &read).data, [0x10]);
+
+    // DTR asserted (RFC 2217 SET-CONTROL 8): RESETN held low, the modem
+    // is off and answers nothing, not even T_REQ.
+    c.send(&com_port(5, &[8]));
+    assert_eq!(c.expect_reply(5), [8], "DTR ON reply");
+    c.set_rts(true);
+    let quiet_until = Instant::now() + Duration::from_millis(400);
+    while Instant::now() < quiet_until {
+        c.pump();
+    }
+    assert!(
+        c.elements.is_empty(),
+        "a modem held in reset said {:?}",
+        c.elements
+    );
+    c.set_rts(false);
+
+    // DTR released (SET-CONTROL 9): the modem boots as at power-on.
+    c.send(&com_port(5, &[9]));
+    assert_eq!(c.expect_reply(5), [9], "DTR OFF reply");
+    let reset = c.next_frame();
+    assert_eq!(reset.code, 0x3E, "BIO_ResetIndication after DTR: {reset:?}");
+    // Table 19: cause 0 (power-on / RESETN), every object at its default.
+    let data = plm_core::st7580::ResetData::from_byte(reset.data[0]);
+    assert_eq!(data.reset_cause, plm_core::st7580::ResetCause::PowerOn);
+    assert!(data.modem_config_error && data.phy_config_error && data.ss_key_error);
+    assert_eq!(ask(&mut c, &read).data, [0x11], "factory Modem_Config");
+
+    drop(c);
+    server.line_containing("disconnected");
+    server.interrupt();
+}

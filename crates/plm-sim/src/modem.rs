@@ -76,6 +76,8 @@ enum Power {
         cause: ResetCause,
     },
     On,
+    /// RESETN held low: off until it is released.
+    Held,
 }
 
 #[derive(Debug, Clone)]
@@ -221,6 +223,27 @@ impl St7580 {
         };
     }
 
+    /// RESETN pulled low (`low`) or released at `now` (a host that wires
+    /// DTR to RESETN): held low, the modem is off, deaf and mute, its
+    /// MIB lost; released, it boots as at power-on (factory MIB,
+    /// BIO_ResetIndication with cause 0 after [`BOOT_TIME`], Table 19).
+    pub fn set_resetn(&mut self, now: Instant, low: bool) {
+        if low && self.power != Power::Held {
+            self.reset(now, ResetCause::PowerOn);
+            self.power = Power::Held;
+        } else if !low && self.power == Power::Held {
+            self.power = Power::Booting {
+                until: now + BOOT_TIME,
+                cause: ResetCause::PowerOn,
+            };
+        }
+    }
+
+    /// Whether RESETN is held low.
+    pub fn resetn_low(&self) -> bool {
+        self.power == Power::Held
+    }
+
     /// The host's T_REQ level changed (`asserted`: low).
     pub fn set_treq(&mut self, now: Instant, asserted: bool) {
         self.treq = asserted;
@@ -244,18 +267,23 @@ impl St7580 {
     pub fn poll_timeout(&self) -> Option<Instant> {
         match &self.power {
             Power::Booting { until, .. } => Some(*until),
+            Power::Held => None,
             Power::On => earliest(self.engine.poll_timeout(), self.tx.as_ref().map(|t| t.end)),
         }
     }
 
     /// Runs whatever is due at `now`.
     pub fn handle_timeout(&mut self, now: Instant) {
-        if let Power::Booting { until, cause } = self.power {
-            if now >= until {
-                self.power = Power::On;
-                self.boot_done(now, cause);
+        match self.power {
+            Power::Booting { until, cause } => {
+                if now >= until {
+                    self.power = Power::On;
+                    self.boot_done(now, cause);
+                }
+                return;
             }
-            return;
+            Power::Held => return,
+            Power::On => {}
         }
         if let Some(job) = self.tx.take_if(|t| now >= t.end) {
             self.tx_done(now, job);

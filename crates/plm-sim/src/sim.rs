@@ -148,6 +148,11 @@ pub enum Fault {
     /// Pull RESETN: the modem restarts with its factory MIB (Table 19
     /// cause 0).
     ModemReset,
+    /// Hold RESETN low (`true`: the modem off, its MIB lost) or release it
+    /// (`false`: it boots with its factory MIB and sends
+    /// BIO_ResetIndication, Table 19 cause 0), as a host that wires DTR
+    /// to RESETN does.
+    Resetn(bool),
     /// The watchdog fires: the modem restarts and keeps the MIB objects
     /// 00h-02h the host wrote (Table 19 cause 1).
     Watchdog,
@@ -545,6 +550,11 @@ impl Sim {
             Fault::CorruptByte(d, m) => self.wire(d).inject(OneShot::Corrupt(m)),
             Fault::DelayByte(d, by) => self.wire(d).inject(OneShot::Delay(by)),
             Fault::ModemReset => self.nodes[0].modem.reset(now, ResetCause::PowerOn),
+            // A concentrator board's USART has no line to RESETN.
+            Fault::Resetn(low) if self.attach == Attach::Modem => {
+                self.nodes[0].modem.set_resetn(now, low)
+            }
+            Fault::Resetn(_) => {}
             Fault::Watchdog => self.nodes[0].modem.reset(now, ResetCause::Watchdog),
             Fault::Unplug => {
                 self.plugged = false;
