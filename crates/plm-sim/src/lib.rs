@@ -36,6 +36,7 @@ pub mod modem;
 pub mod rfu;
 pub mod rng;
 pub mod sim;
+pub mod st7570;
 pub mod street;
 pub mod uart;
 

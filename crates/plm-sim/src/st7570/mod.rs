@@ -1,0 +1,485 @@
+//! The simulated ST7570 (ST7570 UM, seed `003_2edea85fed0bdf2a`): its
+//! host interface through plm-core's device link engine in the ST7570
+//! dialect, its commands through plm-core's `st7570::Command`, its MIB
+//! checks through `st7570::validate`, its status message through
+//! `st7570::Status`. What is simulated here is the chip's state: operating
+//! mode and access layer (00A1h), the MIB values and counters, reset and
+//! auto-reconfiguration (7.1), synchronization as far as one modem alone
+//! knows it, and the requests it refuses (Tables 43, 48, 63).
+//!
+//! The S-FSK line is not here: the model queues [`Transmission`]s for it
+//! ([`St7570::poll_line`]) and takes subframes it hears
+//! ([`St7570::hear`]); see [`slots`]. With nobody on the line a Client's
+//! data request is confirmed LP_OK at the end of its frame, and a Server
+//! never synchronizes (docs/protocol-notes.md, "ST7570: simulated modem").
+//!
+//! - [`store`]: the MIB values, write effects, Tables 149-150.
+//! - [`requests`]: what the chip answers to each request of Table 15.
+//! - [`slots`]: time slots and the seam to the line.
+//! - [`drive`]: plm-core's host engine driving one model in virtual time.
+
+pub mod drive;
+mod requests;
+pub mod slots;
+pub mod store;
+
+use plm_core::link::device::{DeviceEngine, DeviceEvent};
+use plm_core::link::host::Transmit;
+use plm_core::link::Dialect;
+use plm_core::st7570::mib::index;
+use plm_core::st7570::{Command, Layer, Status};
+use plm_core::time::{earliest, Duration, Instant, MS};
+pub use slots::{Heard, SlotClock, SlotUse, Transmission};
+use std::collections::VecDeque;
+pub use store::Store;
+
+/// Time from a reset to the modem answering again (model; the manual
+/// gives none).
+pub const BOOT_TIME: Duration = 20 * MS;
+/// FW_RELEASE of the status message: 1 in this manual (Table 11).
+pub const FW_RELEASE: u8 = 1;
+/// 0001h's local address of a node that has none (Table 6: NEW).
+pub const NEW: u16 = 0x0FFE;
+
+/// Operating modes of 00A1h byte 0 (Table 137).
+pub mod mode {
+    /// IDLE.
+    pub const IDLE: u8 = 0;
+    /// Client.
+    pub const CLIENT: u8 = 1;
+    /// Server.
+    pub const SERVER: u8 = 2;
+    /// Monitor.
+    pub const MONITOR: u8 = 3;
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Power {
+    On,
+    /// Restarting until `until`: deaf and mute. `software`: through
+    /// CMD_ResetRequest, confirmed with 21h once up again (5.3.4).
+    Booting {
+        until: Instant,
+        software: bool,
+    },
+}
+
+/// A request being served on the line: its confirm, when it is due, and
+/// when the modem stops being BUSY.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct TxJob {
+    confirm_at: Instant,
+    confirm: Option<Command>,
+    end: Instant,
+    /// MIB counter to add to at `end`, and by how much.
+    count: Option<(u16, u32)>,
+}
+
+/// A simulated ST7570.
+#[derive(Debug, Clone)]
+pub struct St7570 {
+    engine: DeviceEngine,
+    mib: Store,
+    power: Power,
+    /// Status RESET: the last reset was a software reset (Table 11).
+    software_reset: bool,
+    treq: bool,
+    /// Status ZC_FAIL: the mains PLL is not locked (no slot clock).
+    zc_fail: bool,
+    /// A Server or Monitor found the time slots on a received PRE+SSD.
+    heard_sync: bool,
+    /// A MAC Client synchronizes on its own first transmission (10.3.1).
+    client_found: bool,
+    /// An intelligent synchronization search runs until then (0009h).
+    is_until: Option<Instant>,
+    /// Alarm requests before then are confirmed and not sent (7.2.1).
+    alarm_quiet_until: Instant,
+    jobs: Vec<TxJob>,
+    line_out: VecDeque<Transmission>,
+}
+
+impl St7570 {
+    /// A chip with nothing stored (factory defaults: PHY, IDLE) powering
+    /// on at `now`, its UART strapped to `baud`.
+    pub fn new(baud: u32, now: Instant) -> Self {
+        let mut m = St7570 {
+            engine: DeviceEngine::new(Dialect::St7570, baud),
+            mib: Store::default(),
+            power: Power::On,
+            software_reset: false,
+            treq: false,
+            zc_fail: false,
+            heard_sync: false,
+            client_found: false,
+            is_until: None,
+            alarm_quiet_until: 0,
+            jobs: Vec::new(),
+            line_out: VecDeque::new(),
+        };
+        m.restart(now, false, true);
+        m
+    }
+
+    /// Changes the UART baud rate (the host's rate, strapped on the
+    /// board; T_IC of 5 characters follows it, 5.2.2).
+    pub fn set_baud(&mut self, baud: u32) {
+        self.engine.set_baud(baud);
+    }
+
+    /// The MIB values.
+    pub fn mib(&self) -> &Store {
+        &self.mib
+    }
+
+    /// Whether the modem is up (not restarting).
+    pub fn is_on(&self) -> bool {
+        self.power == Power::On
+    }
+
+    /// The access layer (00A1h byte 12).
+    pub fn layer(&self) -> Layer {
+        self.mib.context().layer
+    }
+
+    /// The operating mode (00A1h byte 0 b0..b2).
+    pub fn mode(&self) -> u8 {
+        self.mib.context().mode
+    }
+
+    /// The slot clock 00A1h sets.
+    pub fn slots(&self) -> SlotClock {
+        SlotClock::of(&self.mib.plc())
+    }
+
+    /// Whether the modem is synchronized: a Client in PHY mode follows the
+    /// mains alone, a MAC Client from its first transmission (10.3.1), a
+    /// Server or Monitor once it heard a PRE+SSD; IDLE and Test modes run
+    /// no time slots, and nothing does without the zero crossing.
+    pub fn synchronized(&self) -> bool {
+        !self.zc_fail
+            && match self.mode() {
+                mode::CLIENT => self.layer() == Layer::Phy || self.client_found,
+                mode::SERVER | mode::MONITOR => self.heard_sync,
+                _ => false,
+            }
+    }
+
+    /// Whether an intelligent synchronization search runs (LM_IS).
+    pub fn is_running(&self) -> bool {
+        self.is_until.is_some()
+    }
+
+    /// Whether a transmission is requested or in progress (status BUSY).
+    pub fn busy(&self) -> bool {
+        !self.jobs.is_empty()
+    }
+
+    /// The status message bits now (Table 11).
+    pub fn status(&self) -> Status {
+        let ctx = self.mib.context();
+        let mac = ctx.layer == Layer::Mac;
+        let repeater = self.mib.tic_repeater();
+        Status {
+            mode: if ctx.mode <= mode::MONITOR {
+                ctx.mode
+            } else {
+                0
+            },
+            mac,
+            new: mac && ctx.mode == mode::SERVER && self.mib.local_address() == NEW,
+            // SYNC is inverted: 1 = not synchronized.
+            sync: !self.synchronized(),
+            busy: self.busy(),
+            reset: self.software_reset,
+            fw_release: FW_RELEASE,
+            zc_fail: self.zc_fail,
+            // INVALID_FRAME is the LSByte of 0006h.
+            invalid_frame: self.mib.counter(store::INVALID_FRAMES) as u8,
+            min_credit: self.mib.byte(store::MIN_DELTA_CREDIT, 0),
+            repeater: repeater.is_repeater(),
+            ..Status::default()
+        }
+    }
+
+    /// The mains zero crossing is lost (`true`) or back: ZC_FAIL, and no
+    /// time slots while it is lost.
+    pub fn set_zc_fail(&mut self, fail: bool) {
+        self.zc_fail = fail;
+        if fail {
+            self.heard_sync = false;
+        }
+        self.refresh_status();
+    }
+
+    /// A hardware reset (power cycle or RESETn) at `now`: the stored
+    /// settings come back through auto-reconfiguration (7.1: "if a reset
+    /// occurs"), the status says RESET = hardware, and no frame follows.
+    pub fn hardware_reset(&mut self, now: Instant) {
+        self.restart(now, true, false);
+    }
+
+    fn restart(&mut self, now: Instant, keep: bool, power_on: bool) {
+        self.mib = self.mib.after_reset(keep);
+        self.software_reset = false;
+        self.heard_sync = false;
+        self.client_found = false;
+        self.is_until = None;
+        self.alarm_quiet_until = 0;
+        self.jobs.clear();
+        self.line_out.clear();
+        self.power = if power_on {
+            Power::On
+        } else {
+            Power::Booting {
+                until: now + BOOT_TIME,
+                software: false,
+            }
+        };
+        if power_on {
+            self.boot_done(now, false);
+        }
+    }
+
+    fn boot_done(&mut self, now: Instant, software: bool) {
+        self.power = Power::On;
+        self.software_reset = software;
+        self.engine.reset();
+        self.engine.set_tic(self.mib.tic_repeater().tic_selector());
+        self.start_is(now);
+        self.refresh_status();
+        if software {
+            // Table 25: RESET = 0, "the reset request has been taken into
+            // account".
+            self.submit(now, Command::ResetRequest { reset: 0 });
+        }
+        if self.treq {
+            self.engine.set_treq(now, true);
+        }
+        self.pump(now);
+    }
+
+    /// The host's T_REQ level changed (`asserted`: low).
+    pub fn set_treq(&mut self, now: Instant, asserted: bool) {
+        self.treq = asserted;
+        if self.is_on() {
+            self.refresh_status();
+            self.engine.set_treq(now, asserted);
+            self.pump(now);
+        }
+    }
+
+    /// Bytes from the host's UART.
+    pub fn handle_rx(&mut self, now: Instant, bytes: &[u8]) {
+        if self.is_on() {
+            self.refresh_status();
+            self.engine.handle_rx(now, bytes);
+            self.pump(now);
+        }
+    }
+
+    /// The next moment [`St7570::handle_timeout`] is due.
+    pub fn poll_timeout(&self) -> Option<Instant> {
+        match self.power {
+            Power::Booting { until, .. } => Some(until),
+            Power::On => {
+                let jobs = self.jobs.iter().map(|j| {
+                    if j.confirm.is_some() {
+                        j.confirm_at
+                    } else {
+                        j.end
+                    }
+                });
+                let mut t = earliest(self.engine.poll_timeout(), self.is_until);
+                for j in jobs {
+                    t = earliest(t, Some(j));
+                }
+                t
+            }
+        }
+    }
+
+    /// Runs whatever is due at `now`.
+    pub fn handle_timeout(&mut self, now: Instant) {
+        if let Power::Booting { until, software } = self.power {
+            if now >= until {
+                self.boot_done(now, software);
+            }
+            return;
+        }
+        self.run_jobs(now);
+        if self.is_until.is_some_and(|t| now >= t) {
+            self.is_until = None;
+            // 5.3.25: no valid frame from an initiator within the timeout
+            // (nobody on the line can have sent one): LM_NOT_LOCKED.
+            self.submit(
+                now,
+                Command::IsIndication {
+                    is_status: 0x02,
+                    locked: None,
+                },
+            );
+        }
+        self.refresh_status();
+        self.engine.handle_timeout(now);
+        self.pump(now);
+    }
+
+    fn run_jobs(&mut self, now: Instant) {
+        let mut i = 0;
+        while i < self.jobs.len() {
+            if self.jobs[i].confirm_at <= now {
+                if let Some(c) = self.jobs[i].confirm.take() {
+                    self.submit(now, c);
+                }
+            }
+            if self.jobs[i].end <= now && self.jobs[i].confirm.is_none() {
+                let job = self.jobs.remove(i);
+                if let Some((index, n)) = job.count {
+                    self.mib.count(index, n);
+                }
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// The next UART output for the host.
+    pub fn poll_transmit(&mut self) -> Option<Vec<u8>> {
+        // The device side only writes bytes; T_REQ is the host's line.
+        loop {
+            if let Transmit::Bytes(b) = self.engine.poll_transmit()? {
+                return Some(b);
+            }
+        }
+    }
+
+    /// The next transmission this modem puts on the line.
+    pub fn poll_line(&mut self) -> Option<Transmission> {
+        self.line_out.pop_front()
+    }
+
+    /// A subframe the line delivered at `now` (3.6: with its estimations).
+    /// In PHY mode a Client, Server or Monitor takes it (a Server or
+    /// Monitor synchronizes on it): the Client and Server indicate the
+    /// PRE+SSD (Table 17) and the P_SDU (Table 37), the Monitor the spy
+    /// indications of a valid subframe (5.3.18, 5.3.20). MAC reception
+    /// (4.5.3, the synchronization machine of 4.6) belongs to the MAC
+    /// network, a later part of issue 12: a MAC modem does not take
+    /// subframes yet, and says so by returning `false`.
+    pub fn hear(&mut self, now: Instant, heard: &Heard) -> bool {
+        if !self.is_on() || self.zc_fail || self.layer() != Layer::Phy {
+            return false;
+        }
+        let mode = self.mode();
+        if !(mode::CLIENT..=mode::MONITOR).contains(&mode) {
+            return false;
+        }
+        let found = !self.synchronized();
+        self.heard_sync = true;
+        let estimate = plm_core::st7570::SyncEstimate {
+            sn: heard.sn,
+            pga: heard.pga,
+            phase: heard.phase,
+        };
+        if mode == mode::MONITOR {
+            if found {
+                self.submit(
+                    now,
+                    Command::SpySynchroFoundIndication {
+                        sn: heard.sn,
+                        demodulation: heard.demodulation,
+                        pga: heard.pga,
+                    },
+                );
+            }
+            self.submit(
+                now,
+                Command::SpySubframeIndication(plm_core::st7570::SpySubframe {
+                    sn: heard.sn,
+                    demodulation: heard.demodulation,
+                    pga: heard.pga,
+                    p_sdu: heard.p_sdu,
+                    snr0: heard.snr.0,
+                    snr1: heard.snr.1,
+                }),
+            );
+        } else {
+            self.submit(now, Command::PhySynchroIndication(estimate));
+            self.submit(
+                now,
+                Command::PhyDataIndication(plm_core::st7570::PhyDataIndication {
+                    p_sdu: heard.p_sdu,
+                    demodulation: heard.demodulation,
+                    snr0: heard.snr.0,
+                    snr1: heard.snr.1,
+                }),
+            );
+        }
+        self.refresh_status();
+        self.pump(now);
+        true
+    }
+
+    /// Starts the intelligent synchronization search of a MAC Server whose
+    /// 0009h is not 0 (minutes), or stops it (5.3.25, 6.5.10).
+    fn start_is(&mut self, now: Instant) {
+        let minutes = self.mib.word(store::IS_TIMEOUT, 0) as u64;
+        let ctx = self.mib.context();
+        self.is_until = (minutes > 0
+            && ctx.layer == Layer::Mac
+            && ctx.mode == mode::SERVER
+            && !self.synchronized())
+        .then(|| now + minutes * 60_000 * MS);
+    }
+
+    fn submit(&mut self, now: Instant, cmd: Command) {
+        self.engine.submit(now, cmd.to_frame());
+    }
+
+    /// Acts on what the link engine reports.
+    fn pump(&mut self, now: Instant) {
+        while let Some(ev) = self.engine.poll_event() {
+            if let DeviceEvent::Request(frame) = ev {
+                if let Some(answer) = self.answer(now, &frame) {
+                    self.submit(now, answer);
+                }
+                if !self.is_on() {
+                    return;
+                }
+            }
+        }
+        self.refresh_status();
+    }
+
+    fn refresh_status(&mut self) {
+        self.engine.set_status(self.status().to_message());
+    }
+
+    /// Drops a Server's synchronization (CMD_DesynchroRequest, 00A0h, a
+    /// mode change).
+    fn lose_sync(&mut self, now: Instant) {
+        self.heard_sync = false;
+        self.client_found = false;
+        self.start_is(now);
+    }
+
+    /// 00A1h's local address after a mode change (4.5.4): a Client takes
+    /// FIMA, a node leaving Client mode is NEW again.
+    fn mode_changed(&mut self, now: Instant, before: u8) {
+        let after = self.mode();
+        let init = self.mib.word(index::LOCAL_INIT_MAC_ADD, 2);
+        let local = if after == mode::CLIENT {
+            Some(self.mib.fima())
+        } else if before == mode::CLIENT {
+            Some(NEW)
+        } else {
+            None
+        };
+        if let Some(local) = local {
+            let mut v = local.to_le_bytes().to_vec();
+            v.extend_from_slice(&init.to_le_bytes());
+            self.mib.set(index::LOCAL_INIT_MAC_ADD, &v);
+        }
+        self.lose_sync(now);
+    }
+}
