@@ -596,4 +596,72 @@ fn a_phy_server_synchronizes_on_what_it_hears() {
         data_confirm(&mut d, Command::PhyDataRequest { p_sdu: vec![1; 38] }),
         0xFF
     );
+    // Half duplex: the rest of its own slot, it hears nothing.
+    let now = d.now();
+    assert!(!d.modem.hear(now, &heard));
+}
+
+#[test]
+fn alarms_heard_are_counted_indicated_and_flagged_once() {
+    let mut d = driver();
+    configure(&mut d, mode::SERVER, PHY);
+    let sn = SignalNoise {
+        s0: 8000,
+        n0: 2000,
+        s1: 8100,
+        n1: 2100,
+    };
+    let now = d.now();
+    assert!(!d.modem.hear_alarm(now, sn), "not synchronized: no slots");
+    configure(&mut d, mode::CLIENT, PHY);
+    let slot = 300 * MS;
+    // The alarm window of slot k: its last 3 bytes.
+    let window = |k: u64| k * slot + 290 * MS;
+    let k = d.now() / slot + 1;
+    let alarm_in = |d: &mut ModemDriver, at: u64| {
+        d.run_for(at - d.now());
+        let now = d.now();
+        d.modem.hear_alarm(now, sn)
+    };
+    let at = window(k);
+    assert!(alarm_in(&mut d, at));
+    assert!(
+        fresh_status(&mut d).alarm,
+        "the next status message says so"
+    );
+    assert!(!fresh_status(&mut d).alarm, "once only");
+    let alarms = |d: &ModemDriver| {
+        d.frames(Layer::Phy)
+            .into_iter()
+            .filter(|c| matches!(c, Command::AlarmIndication { .. }))
+            .collect::<Vec<_>>()
+    };
+    assert!(alarms(&d).is_empty(), "N_RX = 2");
+    let at = window(k + 1);
+    assert!(alarm_in(&mut d, at), "the next slot");
+    d.run_for(50 * MS);
+    assert_eq!(
+        alarms(&d),
+        [Command::AlarmIndication { cnt: 2, long: None }]
+    );
+    // N_REJ = 9 slots of deafness.
+    let at = window(k + 2);
+    assert!(!alarm_in(&mut d, at));
+    assert_eq!(read(&mut d, 0x0083), Ok(2u32.to_le_bytes().to_vec()));
+    // 0086h b2 = 0: the long form, with the estimations.
+    write(&mut d, 0x0086, &[0x00]).unwrap();
+    let at = window(k + 12);
+    assert!(alarm_in(&mut d, at));
+    let at = window(k + 14);
+    assert!(alarm_in(&mut d, at), "not consecutive: counts from 1");
+    let at = window(k + 15);
+    assert!(alarm_in(&mut d, at));
+    d.run_for(50 * MS);
+    assert_eq!(
+        alarms(&d)[1..],
+        [Command::AlarmIndication {
+            cnt: 5,
+            long: Some((sn, 0))
+        }]
+    );
 }

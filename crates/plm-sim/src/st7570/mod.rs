@@ -15,17 +15,19 @@
 //!
 //! - [`store`]: the MIB values, write effects, Tables 149-150.
 //! - [`requests`]: what the chip answers to each request of Table 15.
+//! - `receive`: what it does with subframes and alarms the line delivers.
 //! - [`slots`]: time slots and the seam to the line.
 //! - [`drive`]: plm-core's host engine driving one model in virtual time.
 
 pub mod drive;
+mod receive;
 mod requests;
 pub mod slots;
 pub mod store;
 
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::Transmit;
-use plm_core::link::Dialect;
+use plm_core::link::{Dialect, Element};
 use plm_core::st7570::mib::index;
 use plm_core::st7570::{Command, Layer, Status};
 use plm_core::time::{earliest, Duration, Instant, MS};
@@ -68,6 +70,8 @@ enum Power {
 /// when the modem stops being BUSY.
 #[derive(Debug, Clone, PartialEq, Eq)]
 struct TxJob {
+    /// When its first slot starts on the line.
+    start: Instant,
     confirm_at: Instant,
     confirm: Option<Command>,
     end: Instant,
@@ -94,6 +98,10 @@ pub struct St7570 {
     is_until: Option<Instant>,
     /// Alarm requests before then are confirmed and not sent (7.2.1).
     alarm_quiet_until: Instant,
+    /// The slot of the last alarm heard and how many came in a row (7.2.2).
+    alarm_run: Option<(u64, u8)>,
+    /// Status ALARM: an alarm was heard since the last status message.
+    alarm_flag: bool,
     jobs: Vec<TxJob>,
     line_out: VecDeque<Transmission>,
 }
@@ -113,6 +121,8 @@ impl St7570 {
             client_found: false,
             is_until: None,
             alarm_quiet_until: 0,
+            alarm_run: None,
+            alarm_flag: false,
             jobs: Vec::new(),
             line_out: VecDeque::new(),
         };
@@ -193,6 +203,7 @@ impl St7570 {
             reset: self.software_reset,
             fw_release: FW_RELEASE,
             zc_fail: self.zc_fail,
+            alarm: self.alarm_flag,
             // INVALID_FRAME is the LSByte of 0006h.
             invalid_frame: self.mib.counter(store::INVALID_FRAMES) as u8,
             min_credit: self.mib.byte(store::MIN_DELTA_CREDIT, 0),
@@ -225,6 +236,8 @@ impl St7570 {
         self.client_found = false;
         self.is_until = None;
         self.alarm_quiet_until = 0;
+        self.alarm_run = None;
+        self.alarm_flag = false;
         self.jobs.clear();
         self.line_out.clear();
         self.power = if power_on {
@@ -358,66 +371,10 @@ impl St7570 {
         self.line_out.pop_front()
     }
 
-    /// A subframe the line delivered at `now` (3.6: with its estimations).
-    /// In PHY mode a Client, Server or Monitor takes it (a Server or
-    /// Monitor synchronizes on it): the Client and Server indicate the
-    /// PRE+SSD (Table 17) and the P_SDU (Table 37), the Monitor the spy
-    /// indications of a valid subframe (5.3.18, 5.3.20). MAC reception
-    /// (4.5.3, the synchronization machine of 4.6) belongs to the MAC
-    /// network, a later part of issue 12: a MAC modem does not take
-    /// subframes yet, and says so by returning `false`.
-    pub fn hear(&mut self, now: Instant, heard: &Heard) -> bool {
-        if !self.is_on() || self.zc_fail || self.layer() != Layer::Phy {
-            return false;
-        }
-        let mode = self.mode();
-        if !(mode::CLIENT..=mode::MONITOR).contains(&mode) {
-            return false;
-        }
-        let found = !self.synchronized();
-        self.heard_sync = true;
-        let estimate = plm_core::st7570::SyncEstimate {
-            sn: heard.sn,
-            pga: heard.pga,
-            phase: heard.phase,
-        };
-        if mode == mode::MONITOR {
-            if found {
-                self.submit(
-                    now,
-                    Command::SpySynchroFoundIndication {
-                        sn: heard.sn,
-                        demodulation: heard.demodulation,
-                        pga: heard.pga,
-                    },
-                );
-            }
-            self.submit(
-                now,
-                Command::SpySubframeIndication(plm_core::st7570::SpySubframe {
-                    sn: heard.sn,
-                    demodulation: heard.demodulation,
-                    pga: heard.pga,
-                    p_sdu: heard.p_sdu,
-                    snr0: heard.snr.0,
-                    snr1: heard.snr.1,
-                }),
-            );
-        } else {
-            self.submit(now, Command::PhySynchroIndication(estimate));
-            self.submit(
-                now,
-                Command::PhyDataIndication(plm_core::st7570::PhyDataIndication {
-                    p_sdu: heard.p_sdu,
-                    demodulation: heard.demodulation,
-                    snr0: heard.snr.0,
-                    snr1: heard.snr.1,
-                }),
-            );
-        }
-        self.refresh_status();
-        self.pump(now);
-        true
+    /// Whether one of its own transmissions is on the line at `now` (the
+    /// modem is half duplex: it hears nothing meanwhile).
+    fn on_air(&self, now: Instant) -> bool {
+        self.jobs.iter().any(|j| j.start <= now && now < j.end)
     }
 
     /// Starts the intelligent synchronization search of a MAC Server whose
@@ -439,13 +396,18 @@ impl St7570 {
     /// Acts on what the link engine reports.
     fn pump(&mut self, now: Instant) {
         while let Some(ev) = self.engine.poll_event() {
-            if let DeviceEvent::Request(frame) = ev {
-                if let Some(answer) = self.answer(now, &frame) {
-                    self.submit(now, answer);
+            match ev {
+                DeviceEvent::Request(frame) => {
+                    if let Some(answer) = self.answer(now, &frame) {
+                        self.submit(now, answer);
+                    }
+                    if !self.is_on() {
+                        return;
+                    }
                 }
-                if !self.is_on() {
-                    return;
-                }
+                // Table 11: ALARM is set in one status message only.
+                DeviceEvent::Sent(Element::Status(_)) => self.alarm_flag = false,
+                _ => {}
             }
         }
         self.refresh_status();

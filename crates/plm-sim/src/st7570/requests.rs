@@ -203,6 +203,7 @@ impl St7570 {
         self.queue_line(start, slots);
         let end = self.line_out.back().map_or(start, |t| t.end());
         self.jobs.push(TxJob {
+            start,
             confirm_at,
             confirm: Some(Command::DataConfirm {
                 confirm_code: confirm::OK,
@@ -282,6 +283,7 @@ impl St7570 {
         let end = start + clock.slot * n_tx;
         self.alarm_quiet_until = end + clock.slot * n_rej;
         self.jobs.push(TxJob {
+            start,
             confirm_at: end,
             confirm: ok,
             end,
@@ -328,6 +330,7 @@ impl St7570 {
         self.queue_line(after, vec![SlotUse::RepeaterCall { position }]);
         let end = after + clock.slot;
         self.jobs.push(TxJob {
+            start: after,
             confirm_at: end,
             confirm: Some(Command::RcConfirm {
                 result: confirm::OK,
