@@ -106,6 +106,17 @@ struct SimArgs {
     /// that echo what they hear.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
     nodes: u16,
+    /// Serve nodes 0..N-1 of the line, each on its own RFC 2217 port
+    /// (the --listen port + i; port 0: N free ports), each with its own
+    /// client, T_REQ, baud rate and faults (--nodes grows to N at least).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
+    serve: u16,
+    /// The MIB of the nodes that are not served (they echo what they
+    /// hear): `follow` applies node 0's MIB 00h/01h values as its host
+    /// writes them, so that they hear what node 0 sends; `factory` keeps
+    /// the factory MIB.
+    #[arg(long, value_enum, default_value_t = PeerMib::Follow)]
+    peers: PeerMib,
     /// Serve a street-light concentrator board's USART (application
     /// frames, no T_REQ) with a street of lamps behind it (12 unless
     /// --street says otherwise).
@@ -128,6 +139,15 @@ struct SimArgs {
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+}
+
+/// The MIB of `plm sim`'s echoing peers.
+#[derive(Clone, Copy, ValueEnum)]
+enum PeerMib {
+    /// Node 0's MIB 00h/01h, as its host writes them.
+    Follow,
+    /// The factory MIB.
+    Factory,
 }
 
 fn failure_rate(s: &str) -> Result<f64, String> {
@@ -195,7 +215,14 @@ fn sim(args: SimArgs) -> Result<(), String> {
             "--cold-lamps and --lamp-failures need a street of lamps: add --street N or --board"
                 .into(),
         ),
-        (false, None) => sim_server::World::Modems(args.nodes.into()),
+        (false, None) => sim_server::World::Modems {
+            nodes: args.nodes.into(),
+            serve: args.serve.into(),
+            peers: match args.peers {
+                PeerMib::Follow => plm_sim::Peers::EchoFollowing,
+                PeerMib::Factory => plm_sim::Peers::Echo,
+            },
+        },
     };
     sim_server::run(sim_server::Options {
         listen: args.listen,

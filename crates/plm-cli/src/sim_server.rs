@@ -21,6 +21,12 @@
 //! The modems are powered on (simulated time 0) when the first client
 //! connects, so that it sees the BIO_ResetIndication; later clients find
 //! them running. One client at a time: another one is told so and closed.
+//! With `--serve N`, nodes 0..N-1 of the one line are each served on a
+//! port of their own (the `--listen` port + i, or N free ports with port
+//! 0), each with its own client, T_REQ, DTR, baud rate and faults; the
+//! nodes not served echo, by default with node 0's MIB 00h/01h
+//! (`Peers::EchoFollowing`), with `--peers factory` at the factory MIB.
+//!
 //! When the client goes, T_REQ and DTR are released and the simulation
 //! goes on. DTR is wired to RESETN, as on many USB-UART boards: a client
 //! that asserts it holds the modem off (a DTR pulse resets it, factory
@@ -28,7 +34,7 @@
 //! modem running (the line starts released).
 
 use crate::rfc2217::{self, Action};
-use plm_sim::{Attach, Fault, Sim, SimConfig};
+use plm_sim::{Attach, Fault, Peers, Sim, SimConfig};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -48,8 +54,16 @@ pub const DEFAULT_STREET: usize = 12;
 
 /// What is simulated behind the served port.
 pub enum World {
-    /// Modems: the served one and N-1 echoing peers.
-    Modems(usize),
+    /// Modems: `serve` served ones and the others echoing.
+    Modems {
+        /// Modems on the line.
+        nodes: usize,
+        /// Nodes 0..serve served, each on its own port.
+        serve: usize,
+        /// Who the echoing peers are ([`Peers::Echo`]: factory MIB;
+        /// [`Peers::EchoFollowing`]: node 0's MIB 00h/01h).
+        peers: Peers,
+    },
     /// A street of lamps behind the served modem or concentrator board.
     Street {
         /// Street-light boards on the line.
@@ -76,20 +90,41 @@ pub struct Options {
 
 /// Serves until Ctrl-C (or SIGTERM).
 pub fn run(opts: Options) -> Result<(), String> {
-    let listener = bind(&opts.listen, opts.allow_remote)?;
-    let addr = listener.local_addr().map_err(|e| e.to_string())?;
+    let serve = match opts.world {
+        World::Modems { serve, .. } => serve.max(1),
+        World::Street { .. } => 1,
+    };
+    let listeners = bind_all(&opts.listen, opts.allow_remote, serve)?;
+    let addrs: Vec<SocketAddr> = listeners
+        .iter()
+        .map(|l| l.local_addr().map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()?;
+    let addr = addrs[0];
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
     ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))
         .map_err(|e| format!("cannot catch Ctrl-C: {e}"))?;
 
     let (config, what) = match opts.world {
-        World::Modems(nodes) => (
+        World::Modems {
+            nodes,
+            serve,
+            peers,
+        } => (
             SimConfig {
-                nodes,
+                nodes: nodes.max(serve),
+                served: serve,
+                peers,
                 ..SimConfig::default()
             },
-            format!("simulated ST7580 (node 0 of {nodes}"),
+            if serve > 1 {
+                format!(
+                    "simulated ST7580 line (nodes 0-{} of {nodes} served",
+                    serve - 1
+                )
+            } else {
+                format!("simulated ST7580 (node 0 of {nodes}")
+            },
         ),
         World::Street {
             lamps,
@@ -132,27 +167,49 @@ pub fn run(opts: Options) -> Result<(), String> {
          — connect with e.g. pyserial rfc2217://{addr}",
         opts.seed
     );
+    if serve > 1 {
+        for (i, a) in addrs.iter().enumerate() {
+            println!("plm sim: node {i} on rfc2217://{a}");
+        }
+    }
+    if sim.nodes() > serve {
+        println!(
+            "plm sim: nodes {}-{} echo what they hear, {}",
+            serve,
+            sim.nodes() - 1,
+            match sim_peers(&opts.world) {
+                Peers::EchoFollowing => "with node 0's MIB 00h/01h (as its host writes them)",
+                _ => "with the factory MIB (--peers factory)",
+            }
+        );
+    }
     println!("plm sim: the simulation powers on when the first client connects; Ctrl-C stops");
 
     // Wall-clock time of simulated time 0.
     let mut origin: Option<Instant> = None;
-    let mut client: Option<Client> = None;
+    let mut clients: Vec<Option<Client>> = (0..serve).map(|_| None).collect();
     while !stop.load(Ordering::SeqCst) {
-        match listener.accept() {
-            Ok((stream, peer)) if client.is_some() => refuse(stream, peer),
-            Ok((stream, peer)) => {
-                let start = *origin.get_or_insert_with(Instant::now);
-                advance(&mut sim, start);
-                match Client::open(stream, peer, sim.baud(), greeting) {
-                    Ok(c) => {
-                        println!("plm sim: client {peer} connected");
-                        client = Some(c);
+        for (node, listener) in listeners.iter().enumerate() {
+            match listener.accept() {
+                Ok((stream, peer)) if clients[node].is_some() => refuse(stream, peer),
+                Ok((stream, peer)) => {
+                    let start = *origin.get_or_insert_with(Instant::now);
+                    advance(&mut sim, start);
+                    match Client::open(stream, peer, sim.baud_of(node), greeting) {
+                        Ok(c) => {
+                            if serve > 1 {
+                                println!("plm sim: client {peer} connected to node {node}");
+                            } else {
+                                println!("plm sim: client {peer} connected");
+                            }
+                            clients[node] = Some(c);
+                        }
+                        Err(e) => println!("plm sim: client {peer} lost at once: {e}"),
                     }
-                    Err(e) => println!("plm sim: client {peer} lost at once: {e}"),
                 }
+                Err(e) if e.kind() == ErrorKind::WouldBlock => {}
+                Err(e) => eprintln!("plm sim: accept failed: {e}"),
             }
-            Err(e) if e.kind() == ErrorKind::WouldBlock => {}
-            Err(e) => eprintln!("plm sim: accept failed: {e}"),
         }
         let Some(start) = origin else {
             std::thread::sleep(IDLE);
@@ -160,33 +217,77 @@ pub fn run(opts: Options) -> Result<(), String> {
         };
 
         advance(&mut sim, start);
-        let out: Vec<u8> = sim.host_read().into_iter().map(|(_, b)| b).collect();
         let wait = match sim.next_deadline() {
             Some(t) => Duration::from_micros(t.saturating_sub(sim_now(start))).min(TICK),
             None => IDLE,
         }
         .max(Duration::from_micros(50));
-        let Some(c) = client.as_mut() else {
-            // Nobody on the host side of the UART: the bytes are lost.
+        let connected = clients.iter().filter(|c| c.is_some()).count();
+        if connected == 0 {
+            // Nobody on the host side of the UARTs: the bytes are lost.
+            for node in 0..serve {
+                sim.host_read_of(node);
+            }
             std::thread::sleep(wait);
             continue;
-        };
-        let result = c.send(&out).and_then(|()| c.serve(&mut sim, start, wait));
-        if let Err(why) = result {
-            println!("plm sim: client {} disconnected ({why})", c.peer);
-            client = None;
+        }
+        // Each client waits its share, so that a round of them stays
+        // within the wait (one client: the whole of it).
+        let share = (wait / connected as u32).max(Duration::from_micros(50));
+        for (node, slot) in clients.iter_mut().enumerate() {
             advance(&mut sim, start);
-            // The host is gone: T_REQ and DTR are released (pulled up).
-            sim.set_treq(false);
-            sim.inject(Fault::Resetn(false));
+            let out: Vec<u8> = sim.host_read_of(node).into_iter().map(|(_, b)| b).collect();
+            let Some(c) = slot.as_mut() else {
+                continue;
+            };
+            let result = c
+                .send(&out)
+                .and_then(|()| c.serve(&mut sim, node, start, share));
+            if let Err(why) = result {
+                println!("plm sim: client {} disconnected ({why})", c.peer);
+                *slot = None;
+                advance(&mut sim, start);
+                // The host is gone: T_REQ and DTR are released (pulled up).
+                sim.set_treq_of(node, false);
+                sim.inject_on(node, Fault::Resetn(false));
+            }
         }
     }
-    if let Some(c) = client {
+    for c in clients.into_iter().flatten() {
         let _ = c.stream.shutdown(std::net::Shutdown::Both);
         println!("plm sim: client {} disconnected (stopping)", c.peer);
     }
     println!("plm sim: stopped");
     Ok(())
+}
+
+/// Who the echoing peers of `world` are.
+fn sim_peers(world: &World) -> Peers {
+    match world {
+        World::Modems { peers, .. } => *peers,
+        World::Street { .. } => Peers::Street,
+    }
+}
+
+/// Binds `n` ports: `listen`, then its port + 1, ... (port 0: `n` free
+/// ports).
+fn bind_all(listen: &str, allow_remote: bool, n: usize) -> Result<Vec<TcpListener>, String> {
+    let first = bind(listen, allow_remote)?;
+    let base = first.local_addr().map_err(|e| e.to_string())?;
+    let fixed = !listen.ends_with(":0");
+    let mut all = vec![first];
+    for i in 1..n {
+        let mut a = base;
+        if fixed {
+            let port = u16::try_from(usize::from(base.port()) + i)
+                .map_err(|_| format!("--listen {listen}: no port {i} above it for node {i}"))?;
+            a.set_port(port);
+        } else {
+            a.set_port(0);
+        }
+        all.push(bind(&a.to_string(), allow_remote)?);
+    }
+    Ok(all)
 }
 
 /// Binds `listen`, refusing anything but loopback unless `allow_remote`:
@@ -274,7 +375,13 @@ impl Client {
     }
 
     /// Waits up to `wait` for bytes from the client and carries them out.
-    fn serve(&mut self, sim: &mut Sim, start: Instant, wait: Duration) -> std::io::Result<()> {
+    fn serve(
+        &mut self,
+        sim: &mut Sim,
+        node: usize,
+        start: Instant,
+        wait: Duration,
+    ) -> std::io::Result<()> {
         self.stream.set_read_timeout(Some(wait))?;
         let mut buf = [0u8; 4096];
         let n = match self.stream.read(&mut buf) {
@@ -296,15 +403,15 @@ impl Client {
         let mut reply = Vec::new();
         for action in self.telnet.receive(&buf[..n], &mut reply) {
             match action {
-                Action::Write(data) => sim.write(&data),
-                Action::SetBaud(baud) => sim.set_baud(baud),
-                Action::SetRts(on) => sim.set_treq(on),
+                Action::Write(data) => sim.write_to(node, &data),
+                Action::SetBaud(baud) => sim.set_baud_of(node, baud),
+                Action::SetRts(on) => sim.set_treq_of(node, on),
                 // DTR wired to RESETN, as on many USB-UART boards: asserted
                 // holds the modem in reset, released boots it.
-                Action::SetDtr(on) => sim.inject(Fault::Resetn(on)),
+                Action::SetDtr(on) => sim.inject_on(node, Fault::Resetn(on)),
                 Action::PurgeReceive => {
                     self.held.clear();
-                    sim.host_read();
+                    sim.host_read_of(node);
                 }
                 // Client data goes to the UART at once: nothing is held.
                 Action::PurgeTransmit => {}

@@ -342,3 +342,86 @@ fn a_dtr_pulse_resets_the_modem_to_its_factory_mib() {
     server.line_containing("disconnected");
     server.interrupt();
 }
+
+/// `host:port` of every "node i on rfc2217://" line of `--serve`.
+fn node_addrs(server: &mut Server, n: usize) -> Vec<String> {
+    (0..n)
+        .map(|i| {
+            let line = server.line_containing(&format!("node {i} on rfc2217://"));
+            line.split("rfc2217://").nth(1).unwrap().trim().to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn serve_2_serves_two_modems_of_one_line_each_on_its_own_port() {
+    let mut server = Server::start(&[
+        "--chip",
+        "st7580",
+        "--listen",
+        "127.0.0.1:0",
+        "--serve",
+        "2",
+        "--nodes",
+        "3",
+    ]);
+    let addrs = node_addrs(&mut server, 2);
+    assert_eq!(addrs[0], server.addr, "node 0 is the first address");
+    assert_ne!(addrs[0], addrs[1]);
+    let peers = server.line_containing("echo what they hear");
+    assert!(
+        peers.contains("nodes 2-2") && peers.contains("node 0's MIB"),
+        "{peers}"
+    );
+    let mut clients: Vec<Client> = addrs.iter().map(|a| Client::connect(a)).collect();
+    for (i, c) in clients.iter_mut().enumerate() {
+        server.line_containing(&format!("connected to node {i}"));
+        c.send(&[IAC, WILL, COM_PORT]);
+        c.expect_telnet("DO COM-PORT-OPTION", |t| {
+            *t == Telnet::Negotiation(DO, COM_PORT)
+        });
+        c.set_rts(false);
+        assert_eq!(c.next_frame().code, 0x3E, "node {i}: BIO_ResetIndication");
+    }
+    // Each its own modem: node 1 configured otherwise, node 0 untouched.
+    let write = frame(0x08, &[0x00, 0x10]);
+    assert_eq!(ask(&mut clients[1], &write).code, 0x09);
+    let read = frame(0x0C, &[0x00]);
+    assert_eq!(ask(&mut clients[1], &read).data, [0x10]);
+    assert_eq!(ask(&mut clients[0], &read).data, [0x11]);
+    // A second client of node 1 is refused; node 1's own goes on.
+    let mut other = TcpStream::connect(&addrs[1]).unwrap();
+    other
+        .set_read_timeout(Some(Duration::from_secs(10)))
+        .unwrap();
+    let mut said = String::new();
+    let _ = other.read_to_string(&mut said);
+    assert!(said.contains("busy"), "{said:?}");
+    assert_eq!(ask(&mut clients[1], &read).data, [0x10]);
+    drop(clients);
+    server.interrupt();
+}
+
+#[test]
+fn serve_on_a_fixed_port_takes_the_ports_above_it() {
+    // A free port with a free one above it.
+    let (base, _hold) = loop {
+        let l = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        let port = l.local_addr().unwrap().port();
+        if port < u16::MAX && std::net::TcpListener::bind(("127.0.0.1", port + 1)).is_ok() {
+            drop(l);
+            break (port, ());
+        }
+    };
+    let listen = format!("127.0.0.1:{base}");
+    let mut server = Server::start(&["--listen", &listen, "--serve", "2", "--peers", "factory"]);
+    let addrs = node_addrs(&mut server, 2);
+    assert_eq!(
+        addrs,
+        [
+            format!("127.0.0.1:{base}"),
+            format!("127.0.0.1:{}", base + 1)
+        ]
+    );
+    server.interrupt();
+}

@@ -3,7 +3,10 @@
 //!
 //! Node 0's host is outside: the test, the console or `plm sim` writes
 //! bytes and T_REQ through [`Sim::write`] and [`Sim::set_treq`] and reads
-//! what came back with [`Sim::host_read`]. What those bytes reach is
+//! what came back with [`Sim::host_read`]. With [`SimConfig::served`]
+//! above 1, nodes 1.. up to it have outside hosts too, each its own UART,
+//! T_REQ, baud rate and faults ([`Sim::write_to`], [`Sim::set_treq_of`],
+//! [`Sim::host_read_of`], [`Sim::inject_on`], [`Sim::set_baud_of`]). What those bytes reach is
 //! [`Attach`]: node 0's modem (its host interface), or a concentrator
 //! [`Board`] (its USART). Every other node's host is an [`EchoHost`] that
 //! sends back what its modem hears, or, on a street ([`Peers::Street`]),
@@ -39,6 +42,9 @@ pub struct SimConfig {
     pub attach: Attach,
     /// Who the other nodes' hosts are.
     pub peers: Peers,
+    /// Nodes whose host is outside, 0 up to this (at least 1; more than 1
+    /// only with [`Attach::Modem`] and echoing peers).
+    pub served: usize,
     /// The lamps of a street's boards.
     pub ballast: BallastConfig,
     /// The modulation the street's boards (and a concentrator board)
@@ -55,6 +61,7 @@ impl Default for SimConfig {
             line: LineConfig::default(),
             attach: Attach::Modem,
             peers: Peers::Echo,
+            served: 1,
             ballast: BallastConfig::default(),
             modulation: Modulation::BPsk,
         }
@@ -94,8 +101,13 @@ pub enum Attach {
 /// Who the hosts of nodes 1.. are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Peers {
-    /// Echoing hosts (modem demos and tests).
+    /// Echoing hosts (modem demos and tests), configured at the factory
+    /// defaults.
     Echo,
+    /// Echoing hosts that apply node 0's MIB 00h and 01h values whenever
+    /// they change (as if their host wrote the same), so that they hear
+    /// what node 0 sends whatever its host configured.
+    EchoFollowing,
     /// Street-light controller boards with their lamps.
     Street,
 }
@@ -298,9 +310,14 @@ pub struct Sim {
     line: LineConfig,
     nodes: Vec<Node>,
     queue: BinaryHeap<Reverse<Scheduled>>,
-    host_rx: VecDeque<(Instant, u8)>,
-    plugged: bool,
-    treq: bool,
+    /// Per outside host (index = node): bytes that reached it, whether its
+    /// cable is in, its T_REQ level.
+    host_rx: Vec<VecDeque<(Instant, u8)>>,
+    plugged: Vec<bool>,
+    treq: Vec<bool>,
+    /// Node 0's MIB 00h and 01h as last applied to following peers.
+    followed: [Vec<u8>; 2],
+    peers: Peers,
     log: VecDeque<LineEvent>,
     attach: Attach,
     /// Outside host to the concentrator board's USART ([`Attach::Board`]).
@@ -327,7 +344,7 @@ impl Sim {
     /// from when its host is there to hear them).
     pub fn new(config: SimConfig) -> Sim {
         let mut rng = Rng::new(config.seed);
-        let nodes = (0..config.nodes.max(1))
+        let nodes: Vec<Node> = (0..config.nodes.max(1))
             .map(|i| {
                 let board = |ballast, clock_offset| {
                     Board::new(
@@ -343,8 +360,13 @@ impl Sim {
                 };
                 let host = match (i, config.attach, config.peers) {
                     (0, Attach::Modem, _) => Host::Outside,
+                    (_, Attach::Modem, Peers::Echo | Peers::EchoFollowing) if i < config.served => {
+                        Host::Outside
+                    }
                     (0, Attach::Board, _) => Host::Board(Box::new(board(None, 0).with_usart())),
-                    (_, _, Peers::Echo) => Host::Echo(Box::new(EchoHost::new(config.baud))),
+                    (_, _, Peers::Echo | Peers::EchoFollowing) => {
+                        Host::Echo(Box::new(EchoHost::new(config.baud)))
+                    }
                     (_, _, Peers::Street) => {
                         // Each board's RTC drifted up to 10 minutes; each
                         // ballast has its own stream of chance.
@@ -372,6 +394,11 @@ impl Sim {
                 }
             })
             .collect();
+        let served = nodes
+            .iter()
+            .take_while(|n| matches!(n.host, Host::Outside))
+            .count()
+            .max(1);
         let mut sim = Sim {
             now: 0,
             seq: 0,
@@ -379,9 +406,11 @@ impl Sim {
             line: config.line,
             nodes,
             queue: BinaryHeap::new(),
-            host_rx: VecDeque::new(),
-            plugged: true,
-            treq: false,
+            host_rx: vec![VecDeque::new(); served],
+            plugged: vec![true; served],
+            treq: vec![false; served],
+            followed: Default::default(),
+            peers: config.peers,
             log: VecDeque::new(),
             attach: config.attach,
             usart_down: Wire::new(config.baud),
@@ -539,48 +568,67 @@ impl Sim {
 
     /// Random byte faults on one direction of node 0's UART.
     pub fn set_byte_faults(&mut self, dir: Dir, faults: ByteFaults) {
-        self.wire(dir).faults = faults;
+        self.wire(0, dir).faults = faults;
     }
 
     /// Injects a fault now.
     pub fn inject(&mut self, fault: Fault) {
+        self.inject_on(0, fault);
+    }
+
+    /// Injects a fault on served node `node` now (nothing for another
+    /// node).
+    pub fn inject_on(&mut self, node: usize, fault: Fault) {
+        if node >= self.served() {
+            return;
+        }
         let now = self.now;
         match fault {
-            Fault::DropByte(d) => self.wire(d).inject(OneShot::Drop),
-            Fault::CorruptByte(d, m) => self.wire(d).inject(OneShot::Corrupt(m)),
-            Fault::DelayByte(d, by) => self.wire(d).inject(OneShot::Delay(by)),
-            Fault::ModemReset => self.nodes[0].modem.reset(now, ResetCause::PowerOn),
+            Fault::DropByte(d) => self.wire(node, d).inject(OneShot::Drop),
+            Fault::CorruptByte(d, m) => self.wire(node, d).inject(OneShot::Corrupt(m)),
+            Fault::DelayByte(d, by) => self.wire(node, d).inject(OneShot::Delay(by)),
+            Fault::ModemReset => self.nodes[node].modem.reset(now, ResetCause::PowerOn),
             // A concentrator board's USART has no line to RESETN.
             Fault::Resetn(low) if self.attach == Attach::Modem => {
-                self.nodes[0].modem.set_resetn(now, low)
+                self.nodes[node].modem.set_resetn(now, low)
             }
             Fault::Resetn(_) => {}
-            Fault::Watchdog => self.nodes[0].modem.reset(now, ResetCause::Watchdog),
+            Fault::Watchdog => self.nodes[node].modem.reset(now, ResetCause::Watchdog),
             Fault::Unplug => {
-                self.plugged = false;
-                self.nodes[0].modem.set_treq(now, false);
+                self.plugged[node] = false;
+                self.nodes[node].modem.set_treq(now, false);
             }
             Fault::Plug => {
-                self.plugged = true;
-                let treq = self.treq;
-                self.nodes[0].modem.set_treq(now, treq);
+                self.plugged[node] = true;
+                let treq = self.treq[node];
+                self.nodes[node].modem.set_treq(now, treq);
             }
-            Fault::Temperature(t) => self.nodes[0].modem.temperature = t,
+            Fault::Temperature(t) => self.nodes[node].modem.temperature = t,
         }
-        self.touch(0);
+        self.touch(node);
         self.flush();
+    }
+
+    /// Nodes whose host is outside (0 up to this).
+    pub fn served(&self) -> usize {
+        self.plugged.len()
     }
 
     /// Whether node 0's cable is plugged in.
     pub fn plugged(&self) -> bool {
-        self.plugged
+        self.plugged[0]
     }
 
     /// The outside host's UART baud rate.
     pub fn baud(&self) -> u32 {
-        match self.attach {
-            Attach::Modem => self.nodes[0].down.baud(),
-            Attach::Board => self.usart_down.baud(),
+        self.baud_of(0)
+    }
+
+    /// The UART baud rate of served node `node`'s host.
+    pub fn baud_of(&self, node: usize) -> u32 {
+        match (self.attach, node) {
+            (Attach::Board, 0) => self.usart_down.baud(),
+            _ => self.nodes[node].down.baud(),
         }
     }
 
@@ -588,35 +636,49 @@ impl Sim {
     /// BR0/BR1 pins strapped to match the host, see protocol notes); with
     /// a concentrator board, its USART's.
     pub fn set_baud(&mut self, baud: u32) {
-        if self.attach == Attach::Board {
+        self.set_baud_of(0, baud);
+    }
+
+    /// Sets served node `node`'s UART baud rate, as [`Sim::set_baud`] does
+    /// node 0's.
+    pub fn set_baud_of(&mut self, node: usize, baud: u32) {
+        if node >= self.served() {
+            return;
+        }
+        if self.attach == Attach::Board && node == 0 {
             self.usart_down.set_baud(baud);
             self.usart_up.set_baud(baud);
             return;
         }
-        let n = &mut self.nodes[0];
+        let n = &mut self.nodes[node];
         n.down.set_baud(baud);
         n.up.set_baud(baud);
         n.modem.set_baud(baud);
-        self.touch(0);
+        self.touch(node);
         self.flush();
     }
 
     /// The host writes `bytes` to node 0's UART (or the concentrator
     /// board's USART) now.
     pub fn write(&mut self, bytes: &[u8]) {
-        if !self.plugged {
+        self.write_to(0, bytes);
+    }
+
+    /// The host of served node `node` writes `bytes` to its UART now.
+    pub fn write_to(&mut self, node: usize, bytes: &[u8]) {
+        if !self.plugged.get(node).copied().unwrap_or(false) {
             return;
         }
-        if self.attach == Attach::Board {
+        if self.attach == Attach::Board && node == 0 {
             let arrivals = self.usart_down.write(self.now, bytes, &mut self.rng);
             for (at, byte) in arrivals {
                 self.schedule(at, Ev::ToUsart { byte });
             }
             return;
         }
-        let arrivals = self.nodes[0].down.write(self.now, bytes, &mut self.rng);
+        let arrivals = self.nodes[node].down.write(self.now, bytes, &mut self.rng);
         for (at, byte) in arrivals {
-            self.schedule(at, Ev::ToModem { node: 0, byte });
+            self.schedule(at, Ev::ToModem { node, byte });
         }
     }
 
@@ -624,17 +686,31 @@ impl Sim {
     /// bytes written before have left the UART, as a driver drains its
     /// FIFO before touching RTS.
     pub fn set_treq(&mut self, asserted: bool) {
-        if self.attach == Attach::Board {
+        self.set_treq_of(0, asserted);
+    }
+
+    /// The host of served node `node` sets its T_REQ, as
+    /// [`Sim::set_treq`].
+    pub fn set_treq_of(&mut self, node: usize, asserted: bool) {
+        if self.attach == Attach::Board || node >= self.served() {
             return; // a board's USART has no T_REQ (STEVAL UM 4.6)
         }
-        self.treq = asserted;
-        let at = self.nodes[0].down.drained_at(self.now);
-        self.schedule(at, Ev::Treq { node: 0, asserted });
+        self.treq[node] = asserted;
+        let at = self.nodes[node].down.drained_at(self.now);
+        self.schedule(at, Ev::Treq { node, asserted });
     }
 
     /// Bytes that reached node 0's host by now, with their arrival times.
     pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
-        self.host_rx.drain(..).collect()
+        self.host_read_of(0)
+    }
+
+    /// Bytes that reached served node `node`'s host by now.
+    pub fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
+        match self.host_rx.get_mut(node) {
+            Some(rx) => rx.drain(..).collect(),
+            None => Vec::new(),
+        }
     }
 
     /// The next line event, oldest first (the last few thousand are kept).
@@ -663,14 +739,20 @@ impl Sim {
         self.now = self.now.max(t);
     }
 
-    fn wire(&mut self, dir: Dir) -> &mut Wire {
-        let n = &mut self.nodes[0];
-        match (self.attach, dir) {
-            (Attach::Modem, Dir::HostToModem) => &mut n.down,
-            (Attach::Modem, Dir::ModemToHost) => &mut n.up,
-            (Attach::Board, Dir::HostToModem) => &mut self.usart_down,
-            (Attach::Board, Dir::ModemToHost) => &mut self.usart_up,
+    fn wire(&mut self, node: usize, dir: Dir) -> &mut Wire {
+        let board = self.attach == Attach::Board && node == 0;
+        let n = &mut self.nodes[node];
+        match (board, dir) {
+            (false, Dir::HostToModem) => &mut n.down,
+            (false, Dir::ModemToHost) => &mut n.up,
+            (true, Dir::HostToModem) => &mut self.usart_down,
+            (true, Dir::ModemToHost) => &mut self.usart_up,
         }
+    }
+
+    /// Whether `node`'s host is outside and its cable in.
+    fn connected(&self, node: usize) -> bool {
+        self.plugged.get(node).copied().unwrap_or(true)
     }
 
     fn schedule(&mut self, at: Instant, ev: Ev) {
@@ -741,28 +823,31 @@ impl Sim {
         }
         match ev {
             Ev::ToModem { node, byte } => {
-                if node > 0 || self.plugged {
+                if self.connected(node) {
                     self.nodes[node].modem.handle_rx(now, &[byte]);
                 }
             }
             Ev::ToHost { node, byte } => match &mut self.nodes[node].host {
                 Host::Echo(app) => app.handle_rx(now, &[byte]),
                 Host::Board(b) => b.handle_rx(now, &[byte], &mut self.rng),
-                Host::Outside if self.plugged => self.host_rx.push_back((now, byte)),
-                Host::Outside => {}
+                Host::Outside => {
+                    if self.plugged[node] {
+                        self.host_rx[node].push_back((now, byte));
+                    }
+                }
             },
             Ev::ToUsart { byte } => {
-                if let (true, Host::Board(b)) = (self.plugged, &mut self.nodes[0].host) {
+                if let (true, Host::Board(b)) = (self.plugged[0], &mut self.nodes[0].host) {
                     b.usart_rx(now, &[byte], &mut self.rng);
                 }
             }
             Ev::FromUsart { byte } => {
-                if self.plugged {
-                    self.host_rx.push_back((now, byte));
+                if self.plugged[0] {
+                    self.host_rx[0].push_back((now, byte));
                 }
             }
             Ev::Treq { node, asserted } => {
-                if node > 0 || self.plugged {
+                if self.connected(node) {
                     self.nodes[node].modem.set_treq(now, asserted);
                 }
             }
@@ -810,6 +895,32 @@ impl Sim {
                 }
             }
             self.refresh_deadline(i);
+        }
+        self.follow_node_0();
+    }
+
+    /// [`Peers::EchoFollowing`]: node 0's MIB 00h and 01h, when they
+    /// changed, applied to every echoing peer.
+    fn follow_node_0(&mut self) {
+        if self.peers != Peers::EchoFollowing {
+            return;
+        }
+        for index in [0u8, 1] {
+            let Some(now) = self.nodes[0].modem.mib(index) else {
+                continue;
+            };
+            if self.followed[index as usize] == now {
+                continue;
+            }
+            let now = now.to_vec();
+            for i in 1..self.nodes.len() {
+                if let Host::Echo(_) = self.nodes[i].host {
+                    // Node 0's modem took the value: a peer takes it too
+                    // (a MIB value only: no output, no new deadline).
+                    let _ = self.nodes[i].modem.configure(index, &now);
+                }
+            }
+            self.followed[index as usize] = now;
         }
     }
 
