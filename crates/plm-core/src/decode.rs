@@ -16,10 +16,13 @@
 //! `layer`; MIB frames that carry their index). Frames from the ST7570's
 //! power line itself are [`decode_line`]'s ([`LineDecoded`]).
 
+#[cfg(feature = "st7570")]
 mod st7570;
+#[cfg(feature = "st7570")]
 mod st7570_line;
 mod st7580;
 
+#[cfg(feature = "st7570")]
 pub use st7570_line::{decode_line, LineDecoded};
 
 use crate::field::{Field, Value};
@@ -108,7 +111,13 @@ pub(crate) fn put_hex(map: &mut Object, key: &str, bytes: &[u8]) {
 #[derive(Debug, Clone)]
 enum Chip {
     St7580(st7580::Context),
+    #[cfg(feature = "st7570")]
     St7570(st7570::Context),
+    /// The ST7570 without its names (plm-core built without the `st7570`
+    /// feature, as the console is until it speaks the chip): frames,
+    /// status messages and the rest at the link level only.
+    #[cfg(not(feature = "st7570"))]
+    Unnamed,
 }
 
 impl Chip {
@@ -116,7 +125,10 @@ impl Chip {
     fn new(dialect: Dialect) -> Chip {
         match dialect {
             Dialect::St7580 => Chip::St7580(st7580::Context::default()),
+            #[cfg(feature = "st7570")]
             Dialect::St7570 => Chip::St7570(st7570::Context::default()),
+            #[cfg(not(feature = "st7570"))]
+            Dialect::St7570 => Chip::Unnamed,
         }
     }
 
@@ -124,7 +136,12 @@ impl Chip {
     fn frame(&mut self, from: Source, frame: &LocalFrame, d: &mut Decoded) {
         match self {
             Chip::St7580(c) => c.frame(frame, d),
+            #[cfg(feature = "st7570")]
             Chip::St7570(c) => c.frame(from, frame, d),
+            #[cfg(not(feature = "st7570"))]
+            Chip::Unnamed => {
+                let _ = (from, frame, d);
+            }
         }
     }
 
@@ -132,7 +149,12 @@ impl Chip {
     fn status(&mut self, data: &[u8], d: &mut Decoded) {
         match self {
             Chip::St7580(_) => st7580::status(data, d),
+            #[cfg(feature = "st7570")]
             Chip::St7570(c) => c.status(data, d),
+            #[cfg(not(feature = "st7570"))]
+            Chip::Unnamed => {
+                let _ = (data, d);
+            }
         }
     }
 }
@@ -174,6 +196,7 @@ impl Decoder {
     /// MIB 00A1h frames in the input say (`plm decode --layer`). Without
     /// it the layer is PHY (the factory default of 00A1h) until the input
     /// says otherwise. No effect on an ST7580 decoder.
+    #[cfg(feature = "st7570")]
     pub fn fix_layer(&mut self, layer: crate::st7570::Layer) {
         if let Chip::St7570(c) = &mut self.chip {
             c.fix_layer(layer);
