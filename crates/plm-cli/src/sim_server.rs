@@ -231,9 +231,14 @@ pub fn run(opts: Options) -> Result<(), String> {
             std::thread::sleep(wait);
             continue;
         }
-        // Each client waits its share, so that a round of them stays
-        // within the wait (one client: the whole of it).
-        let share = (wait / connected as u32).max(Duration::from_micros(50));
+        // One client waits the whole of it; several take turns of a share
+        // of TICK, so that one client's bytes never wait out another's
+        // idle read (a T_REQ edge must meet its status within 20 ms).
+        let share = if connected > 1 {
+            (wait.min(TICK) / connected as u32).max(Duration::from_micros(50))
+        } else {
+            wait
+        };
         for (node, slot) in clients.iter_mut().enumerate() {
             advance(&mut sim, start);
             let out: Vec<u8> = sim.host_read_of(node).into_iter().map(|(_, b)| b).collect();

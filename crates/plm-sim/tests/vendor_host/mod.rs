@@ -74,6 +74,8 @@ pub struct Stats {
     pub max_status_wait: Duration,
     pub late_statuses: usize,
     pub max_raw_status_wait: Duration,
+    /// The late ones: (edge, end of the modem's last frame, status).
+    pub late: Vec<(Instant, Instant, Instant)>,
     /// Modem frames, and their repeats (STX 03h) caused by our late ACKs.
     pub frames: usize,
     pub repeats: usize,
@@ -109,6 +111,8 @@ pub struct VendorHost {
     seq: u8,
     next_trigger: Option<Instant>,
     configured: bool,
+    /// No new trigger after this (the demo winds down).
+    stopped: bool,
     /// The data request whose ACK is awaited (to read a MIB object then).
     pub stats: Stats,
 }
@@ -161,6 +165,7 @@ impl VendorHost {
             seq: 0,
             next_trigger: None,
             configured: false,
+            stopped: false,
             stats: Stats::default(),
         }
     }
@@ -193,6 +198,9 @@ impl VendorHost {
             return None;
         }
         let t = self.out.pop_front()?;
+        if std::env::var_os("VENDOR_TRACE").is_some() {
+            eprintln!("{:?} {now} out {t:?}", self.role);
+        }
         if let Transmit::TReq { asserted: true } = t {
             self.stats.edges += 1;
             self.edge = Some(now);
@@ -246,6 +254,9 @@ impl VendorHost {
     }
 
     fn on_event(&mut self, now: Instant, e: Event) {
+        if std::env::var_os("VENDOR_TRACE").is_some() {
+            eprintln!("{:?} {now} arrived {} {e:?}", self.role, self.arrived);
+        }
         match e {
             Event::Received(Element::Status(s)) => {
                 self.stats.statuses += 1;
@@ -260,6 +271,7 @@ impl VendorHost {
                     self.stats.max_raw_status_wait = self.stats.max_raw_status_wait.max(raw);
                     self.stats.max_status_wait = self.stats.max_status_wait.max(wait);
                     if wait > 20 * MS {
+                        self.stats.late.push((edge, self.modem_frame_end, at));
                         self.stats.late_statuses += 1;
                     }
                 }
@@ -350,6 +362,9 @@ impl VendorHost {
     /// The program's own work: the next request, one at a time (each
     /// waits for the ACK of the one before, as a blocking driver does).
     fn app(&mut self, now: Instant) {
+        if self.stopped {
+            self.next_trigger = None;
+        }
         if self.role == Role::Master && self.next_trigger.is_some_and(|t| t <= now) {
             self.seq = self.seq.wrapping_add(1);
             let mut trigger = vec![0x5A; TRIGGER_LEN];
@@ -364,6 +379,12 @@ impl VendorHost {
                 self.tickets.push_back((t, cmd.code()));
             }
         }
+    }
+
+    /// Sends no new trigger from now on: what is under way finishes.
+    pub fn stop(&mut self) {
+        self.stopped = true;
+        self.next_trigger = None;
     }
 
     /// Requests submitted and not yet ACKed or given up.
