@@ -490,3 +490,23 @@ fn a_mixed_stream_gives_one_line_per_element() {
     assert_eq!(kinds, ["status", "ack", "frame", "nak", "garbage"]);
     assert_eq!(lines[4]["hex"], "aabb");
 }
+
+#[test]
+fn a_repeat_is_named_and_an_ack_after_it_is_late() {
+    // PingConfirm, its repeat with no ACK in between (the host's ACK came
+    // after T_ACK, issue 15), then that late ACK and the repeat's own;
+    // then a frame NAKed and repeated: a repeat, nothing late.
+    let out = decode_st7580("02012d113f00 03012d113f00 06 06 02012d124000 15 03012d124000 06");
+    let repeat: Vec<bool> = out.iter().map(|o| o["repeat"] == true).collect();
+    let late: Vec<bool> = out.iter().map(|o| o["after_t_ack"] == true).collect();
+    assert_eq!(
+        repeat,
+        [false, true, false, false, false, false, true, false]
+    );
+    assert_eq!(
+        late,
+        [false, false, true, false, false, false, false, false]
+    );
+    // Absent, not false, where nothing is to be said.
+    assert!(out[0].get("repeat").is_none() && out[3].get("after_t_ack").is_none());
+}

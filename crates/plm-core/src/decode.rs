@@ -7,7 +7,12 @@
 //! - frames: `stx`, `length`, `code`, `command` (the manual's name, `null`
 //!   for an unknown code), `checksum`, `checksum_ok`, and `fields` named
 //!   after the manual's labels in snake_case;
-//! - `error` when the data does not fit the command, `reason` for garbage.
+//! - `error` when the data does not fit the command, `reason` for garbage;
+//! - ST7580: `repeat: true` on a frame with STX 03h (the modem's repeat,
+//!   UM0932 3.2.7), and `after_t_ack: true` on the host's ACK that the
+//!   capture shows came after that repeat had started, so after T_ACK (the
+//!   original had no ACK or NAK before its repeat): the reason the modem
+//!   repeated, for someone debugging their own host code.
 //!
 //! What differs between the chips is answered by the chip's module, chosen
 //! once from the dialect ([`Chip::new`]): [`st7580`] (MIB_ReadConfirm named
@@ -62,6 +67,13 @@ pub struct Decoded {
     pub error: Option<String>,
     /// Why bytes are garbage: `unexpected` or `truncated`.
     pub reason: Option<String>,
+    /// ST7580: a frame with STX 03h, the repeat of the frame before it
+    /// (UM0932 3.2.7).
+    pub repeat: Option<bool>,
+    /// ST7580: an ACK that came after the modem had started repeating the
+    /// frame it answers, so after T_ACK (UM0932 3.2.7); known only from a
+    /// capture of both directions.
+    pub after_t_ack: Option<bool>,
 }
 
 // The object `plm decode` prints, and the console exports and imports.
@@ -79,6 +91,8 @@ json_record!(Decoded {
     fields,
     error,
     reason,
+    repeat,
+    after_t_ack,
 });
 
 /// A field value as JSON: numbers as numbers, enums by the manual's name,
@@ -170,6 +184,12 @@ pub struct Decoder {
     source: Source,
     stream: StreamDecoder,
     chip: Chip,
+    /// ST7580: the last frame with STX 02h had no ACK or NAK before its
+    /// repeat came: the next ACK is late.
+    ack_overdue: bool,
+    /// ST7580: the last frame with STX 02h, and whether an ACK or NAK
+    /// followed it.
+    last_first: Option<(LocalFrame, bool)>,
 }
 
 impl Decoder {
@@ -180,6 +200,8 @@ impl Decoder {
             source,
             stream: StreamDecoder::new(dialect, source),
             chip: Chip::new(dialect),
+            ack_overdue: false,
+            last_first: None,
         }
     }
 
@@ -240,7 +262,12 @@ impl Decoder {
             fields: None,
             error: None,
             reason: None,
+            repeat: None,
+            after_t_ack: None,
         };
+        if self.dialect == Dialect::St7580 {
+            self.repeats(e, &mut d);
+        }
         match e {
             Element::Frame {
                 frame,
@@ -267,6 +294,37 @@ impl Decoder {
             Element::Ack | Element::Nak => {}
         }
         d
+    }
+}
+
+impl Decoder {
+    /// UM0932 3.2.7: the modem repeats a frame with STX 03h once, T_ACK
+    /// after it, when no ACK came. A repeat whose original had neither ACK
+    /// nor NAK before it makes the next ACK a late one.
+    fn repeats(&mut self, e: &Element, d: &mut Decoded) {
+        match e {
+            Element::Frame { frame, .. } if frame.stx == crate::link::Stx::Repeat => {
+                d.repeat = Some(true);
+                if let Some((first, answered)) = self.last_first.take() {
+                    self.ack_overdue =
+                        !answered && first.code == frame.code && first.data == frame.data;
+                }
+            }
+            Element::Frame { frame, .. } => {
+                self.last_first = Some((frame.clone(), false));
+                self.ack_overdue = false;
+            }
+            Element::Ack | Element::Nak => {
+                if let Some((_, answered)) = &mut self.last_first {
+                    *answered = true;
+                }
+                if *e == Element::Ack && self.ack_overdue {
+                    d.after_t_ack = Some(true);
+                }
+                self.ack_overdue = false;
+            }
+            _ => {}
+        }
     }
 }
 

@@ -142,6 +142,8 @@ impl AppDecoded {
             fields: Some(fields),
             error: self.error.clone(),
             reason: None,
+            repeat: None,
+            after_t_ack: None,
         }
     }
 
