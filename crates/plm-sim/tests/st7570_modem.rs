@@ -319,6 +319,16 @@ fn status_bits_follow_mode_and_layer() {
     let s = fresh_status(&mut d);
     assert_eq!((s.mode, s.mac), (mode::CLIENT, false));
     assert!(s.synchronized());
+    // Without the zero crossing there are no slots (ZC_FAIL, LP_NS).
+    let now = d.now();
+    d.modem.set_zc_fail(now, true);
+    let s = fresh_status(&mut d);
+    assert!(s.zc_fail && !s.synchronized());
+    let p_sdu = Command::PhyDataRequest { p_sdu: vec![0; 38] };
+    assert_eq!(data_confirm(&mut d, p_sdu), 0x04);
+    let now = d.now();
+    d.modem.set_zc_fail(now, false);
+    assert!(fresh_status(&mut d).synchronized());
     // A MAC Client is synchronized by its first transmission (10.3.1).
     configure(&mut d, mode::CLIENT, MAC);
     assert!(!fresh_status(&mut d).synchronized());
@@ -596,6 +606,17 @@ fn a_phy_server_synchronizes_on_what_it_hears() {
         data_confirm(&mut d, Command::PhyDataRequest { p_sdu: vec![1; 38] }),
         0xFF
     );
+    // 6.5.14-6.5.15: the estimations of the last data indication.
+    let le = |v: &[u32]| -> Vec<u8> {
+        let mut out = Vec::new();
+        for (i, x) in v.iter().enumerate() {
+            let n = if i == 2 { 2 } else { 4 };
+            out.extend_from_slice(&x.to_le_bytes()[..n]);
+        }
+        out
+    };
+    assert_eq!(read(&mut d, 0x000D), Ok(le(&[9000, 3000, 3])));
+    assert_eq!(read(&mut d, 0x000E), Ok(le(&[9100, 3100, 1])));
     // Half duplex: the rest of its own slot, it hears nothing.
     let now = d.now();
     assert!(!d.modem.hear(now, &heard));
@@ -663,5 +684,67 @@ fn alarms_heard_are_counted_indicated_and_flagged_once() {
             cnt: 5,
             long: Some((sn, 0))
         }]
+    );
+}
+
+#[test]
+fn a_phy_monitor_searches_slot_by_slot_until_it_hears_a_subframe() {
+    let mut d = driver();
+    configure(&mut d, mode::MONITOR, PHY);
+    let slot = 300 * MS;
+    let t0 = d.now();
+    d.run_for(3_000 * MS);
+    let searching = |d: &ModemDriver| {
+        d.events
+            .iter()
+            .filter(|(_, e)| matches!(e, Event::Frame(f) if f.code == 0xC0))
+            .map(|(t, _)| *t)
+            .collect::<Vec<_>>()
+    };
+    // 5.3.19: one at the start of each slot, nothing between.
+    let starts = d.now() / slot - t0 / slot;
+    let seen = searching(&d);
+    assert_eq!(seen.len() as u64, starts, "{seen:?}");
+    for t in &seen {
+        assert!(t % slot < 10 * MS, "at a slot start: {t}");
+    }
+    let heard = Heard {
+        p_sdu: [7; 38],
+        sn: SignalNoise {
+            s0: 1,
+            n0: 2,
+            s1: 3,
+            n1: 4,
+        },
+        pga: 5,
+        phase: 0,
+        demodulation: Demodulation {
+            ask0: 4,
+            ask1: 0,
+            fsk: 300,
+        },
+        snr: (6, 7),
+    };
+    let now = d.now();
+    assert!(d.modem.hear(now, &heard));
+    d.run_for(3_000 * MS);
+    assert_eq!(
+        searching(&d).len(),
+        seen.len(),
+        "synchronized: no more search"
+    );
+    let spy: Vec<Command> = d
+        .frames(Layer::Phy)
+        .into_iter()
+        .filter(|c| c.code() >= 0xB0 && c.code() <= 0xD0)
+        .filter(|c| *c != Command::SpySearchSynchroIndication)
+        .collect();
+    assert_eq!(spy.len(), 2, "{spy:?}");
+    assert!(matches!(
+        spy[0],
+        Command::SpySynchroFoundIndication { pga: 5, .. }
+    ));
+    assert!(
+        matches!(&spy[1], Command::SpySubframeIndication(s) if s.p_sdu == [7; 38] && s.snr1 == 7)
     );
 }

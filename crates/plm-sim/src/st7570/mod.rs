@@ -102,6 +102,9 @@ pub struct St7570 {
     alarm_run: Option<(u64, u8)>,
     /// Status ALARM: an alarm was heard since the last status message.
     alarm_flag: bool,
+    /// A PHY Monitor searching for the slots sends SPY_SearchSynchro-
+    /// Indication at every slot start after this moment (5.3.19).
+    spy_from: Instant,
     jobs: Vec<TxJob>,
     line_out: VecDeque<Transmission>,
 }
@@ -123,6 +126,7 @@ impl St7570 {
             alarm_quiet_until: 0,
             alarm_run: None,
             alarm_flag: false,
+            spy_from: 0,
             jobs: Vec::new(),
             line_out: VecDeque::new(),
         };
@@ -214,8 +218,9 @@ impl St7570 {
 
     /// The mains zero crossing is lost (`true`) or back: ZC_FAIL, and no
     /// time slots while it is lost.
-    pub fn set_zc_fail(&mut self, fail: bool) {
+    pub fn set_zc_fail(&mut self, now: Instant, fail: bool) {
         self.zc_fail = fail;
+        self.spy_from = now;
         if fail {
             self.heard_sync = false;
         }
@@ -255,6 +260,7 @@ impl St7570 {
 
     fn boot_done(&mut self, now: Instant, software: bool) {
         self.power = Power::On;
+        self.spy_from = now;
         self.software_reset = software;
         self.engine.reset();
         self.engine.set_tic(self.mib.tic_repeater().tic_selector());
@@ -303,6 +309,7 @@ impl St7570 {
                     }
                 });
                 let mut t = earliest(self.engine.poll_timeout(), self.is_until);
+                t = earliest(t, self.spy_due());
                 for j in jobs {
                     t = earliest(t, Some(j));
                 }
@@ -320,6 +327,7 @@ impl St7570 {
             return;
         }
         self.run_jobs(now);
+        self.spy_tick(now);
         if self.is_until.is_some_and(|t| now >= t) {
             self.is_until = None;
             // 5.3.25: no valid frame from an initiator within the timeout
@@ -421,6 +429,7 @@ impl St7570 {
     /// mode change).
     fn lose_sync(&mut self, now: Instant) {
         self.heard_sync = false;
+        self.spy_from = now;
         self.client_found = false;
         self.start_is(now);
     }

@@ -1,9 +1,11 @@
 //! What the simulated ST7570 does with what the line delivers: a PHY
-//! subframe with its estimations (3.6, 5.3.1, 5.3.11, 5.3.18, 5.3.20) and
-//! alarms (7.2.2, 5.3.14).
+//! subframe with its estimations (3.6, 5.3.1, 5.3.11, 5.3.18, 5.3.20;
+//! 000Dh, 000Eh) and alarms (7.2.2, 5.3.14); and what a PHY Monitor says
+//! at each slot while it searches for the slots (5.3.19).
 
 use super::slots::Heard;
 use super::{mode, store, St7570};
+use plm_core::st7570::mib::object;
 use plm_core::st7570::{Command, Layer, SignalNoise};
 use plm_core::time::Instant;
 
@@ -15,6 +17,9 @@ const SN_INDICATION_DISABLED: u8 = 1 << 2;
 const ALARM_FLAGS: u16 = 0x0086;
 /// 0083h Received alarm counter.
 const RECEIVED_ALARMS: u16 = 0x0083;
+/// 000Dh S0, N0, PGA and 000Eh S1, N1, phase.
+const S0_N0_PGA: u16 = 0x000D;
+const S1_N1_PHASE: u16 = 0x000E;
 
 impl St7570 {
     /// A subframe the line delivered at `now` (3.6: with its estimations).
@@ -64,6 +69,7 @@ impl St7570 {
                 }),
             );
         } else {
+            self.store_estimations(heard);
             self.submit(now, Command::PhySynchroIndication(estimate));
             self.submit(
                 now,
@@ -120,5 +126,55 @@ impl St7570 {
         self.refresh_status();
         self.pump(now);
         true
+    }
+
+    /// 6.5.14-6.5.15: 000Dh and 000Eh hold the estimations of the last
+    /// CMD_DataIndication, written through their layouts.
+    fn store_estimations(&mut self, heard: &Heard) {
+        let sn = heard.sn;
+        for (index, values) in [
+            (
+                S0_N0_PGA,
+                [("s0", sn.s0), ("n0", sn.n0), ("pga", heard.pga as u32)],
+            ),
+            (
+                S1_N1_PHASE,
+                [("s1", sn.s1), ("n1", sn.n1), ("phase", heard.phase as u32)],
+            ),
+        ] {
+            let Some(o) = object(index) else { continue };
+            let mut v = o.default.to_vec();
+            for (name, value) in values {
+                if let Some(f) = o.field(name) {
+                    f.set(&mut v, value as i64);
+                }
+            }
+            self.mib.set(index, &v);
+        }
+    }
+
+    /// Whether this is a PHY Monitor searching for the slots: it says so
+    /// at the start of each slot (5.3.19), the mains being there.
+    fn searching_spy(&self) -> bool {
+        self.is_on()
+            && !self.zc_fail
+            && self.layer() == Layer::Phy
+            && self.mode() == mode::MONITOR
+            && !self.synchronized()
+    }
+
+    /// The next SPY_SearchSynchroIndication, if one is due.
+    pub(super) fn spy_due(&self) -> Option<Instant> {
+        self.searching_spy()
+            .then(|| self.slots().next_slot(self.spy_from))
+    }
+
+    /// Sends the SPY_SearchSynchroIndication of a slot start that passed.
+    pub(super) fn spy_tick(&mut self, now: Instant) {
+        if self.spy_due().is_some_and(|t| t <= now) {
+            let slot = self.slots().slot;
+            self.spy_from = now / slot * slot;
+            self.submit(now, Command::SpySearchSynchroIndication);
+        }
     }
 }
