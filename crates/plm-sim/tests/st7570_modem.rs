@@ -13,7 +13,7 @@ use plm_core::st7570::{
 };
 use plm_core::time::MS;
 use plm_sim::st7570::drive::{ModemDriver, Outcome};
-use plm_sim::st7570::{mode, Heard, SlotUse, NEW};
+use plm_sim::st7570::{mode, Heard, SlotUse, TestTone, NEW};
 
 const PHY: u8 = 1;
 const MAC: u8 = 2;
@@ -360,8 +360,22 @@ fn status_bits_follow_mode_and_layer() {
     // Monitor and Test modes.
     configure(&mut d, mode::MONITOR, PHY);
     assert_eq!(fresh_status(&mut d).mode, mode::MONITOR);
+    assert_eq!(d.modem.test_tone(), None);
     configure(&mut d, 4, PHY);
     assert_eq!(fresh_status(&mut d).mode, 0, "Test modes share MODE 0");
+    // Table 137: a continuous tone on ch.0, ch.1, or both in turn.
+    let p = PlcConfiguration::decode(&plc(0, PHY));
+    assert_eq!(
+        d.modem.test_tone(),
+        Some((TestTone::Single(p.f0), p.target_output_gain))
+    );
+    configure(&mut d, 6, PHY);
+    assert_eq!(
+        d.modem.test_tone(),
+        Some((TestTone::Alternate(p.f0, p.f1), 0x10))
+    );
+    let p_sdu = Command::PhyDataRequest { p_sdu: vec![0; 38] };
+    assert_eq!(data_confirm(&mut d, p_sdu), 0x04, "no time slots");
 }
 
 #[test]

@@ -31,7 +31,7 @@ use plm_core::link::{Dialect, Element};
 use plm_core::st7570::mib::index;
 use plm_core::st7570::{Command, Layer, Status};
 use plm_core::time::{earliest, Duration, Instant, MS};
-pub use slots::{Heard, SlotClock, SlotUse, Transmission};
+pub use slots::{Heard, SlotClock, SlotUse, TestTone, Transmission};
 use std::collections::VecDeque;
 pub use store::Store;
 
@@ -158,6 +158,16 @@ impl St7570 {
     /// The operating mode (00A1h byte 0 b0..b2).
     pub fn mode(&self) -> u8 {
         self.mib.context().mode
+    }
+
+    /// The tone a Test mode sends, and its gain (0..31), while the modem
+    /// is up: the line reads it rather than a queue, the tone having no
+    /// slots and no end.
+    pub fn test_tone(&self) -> Option<(TestTone, u8)> {
+        let plc = self.mib.plc();
+        TestTone::of(&plc)
+            .filter(|_| self.is_on())
+            .map(|t| (t, plc.target_output_gain))
     }
 
     /// The slot clock 00A1h sets.

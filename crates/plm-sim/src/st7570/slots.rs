@@ -132,6 +132,28 @@ impl Transmission {
     }
 }
 
+/// What a modem in a Test mode puts on the line, continuously and with no
+/// time slots (00A1h operating modes 4-6, Table 137), at the target gain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TestTone {
+    /// Mode 4 or 5: one tone (f0 or f1), in Hz.
+    Single(u32),
+    /// Mode 6: f0 and f1 in turn, in Hz.
+    Alternate(u32, u32),
+}
+
+impl TestTone {
+    /// The tone of an operating mode, `None` outside the Test modes.
+    pub fn of(plc: &PlcConfiguration) -> Option<TestTone> {
+        match plc.operating_mode {
+            4 => Some(TestTone::Single(plc.f0)),
+            5 => Some(TestTone::Single(plc.f1)),
+            6 => Some(TestTone::Alternate(plc.f0, plc.f1)),
+            _ => None,
+        }
+    }
+}
+
 /// A subframe the line delivered to this modem, with what its receiver
 /// measured on the PRE+SSD and the P_SDU (3.6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
