@@ -42,6 +42,40 @@ fn point_to_point_demo_through_plm_sim_serve_2() {
         VendorHost::new(Role::Master, 57_600, us()),
         VendorHost::new(Role::Slave, 57_600, us()),
     ];
+    // Bytes cross two processes and TCP: on a loaded machine a frame can
+    // come in two bursts more than 10 ms apart, which the real chip's
+    // T_IC would cut (a known limit of the host interface, protocol-notes
+    // "Known limits"); these hosts receive with 30 ms, as a host behind a
+    // USB bridge may.
+    for h in &mut hosts {
+        h.set_receive_tic(30_000);
+    }
+    // The slave configures its modem first (117 kHz, DL): a trigger sent
+    // before that is not heard, as on a real bench.
+    while !hosts[1].configured() {
+        let link = &mut links[1];
+        link.pump(Duration::from_micros(200));
+        link.telnet.clear();
+        let data = link.take_data();
+        let now = us();
+        let h = &mut hosts[1];
+        if !data.is_empty() {
+            h.handle_rx(now, now, &data);
+        }
+        if h.poll_timeout().is_some_and(|t| t <= now) {
+            h.handle_timeout(now);
+        }
+        while let Some(t) = h.poll_transmit(now) {
+            match t {
+                Transmit::Bytes(b) => link.send_data(&b),
+                Transmit::TReq { asserted } => link.set_rts(asserted).unwrap(),
+            }
+        }
+        assert!(
+            start.elapsed() < WAIT,
+            "the slave's modem was not configured"
+        );
+    }
     // The demo for RUN, then a second and a half to finish what is under
     // way (no new trigger).
     while start.elapsed() < RUN + Duration::from_millis(1_500) {
@@ -97,7 +131,6 @@ fn point_to_point_demo_through_plm_sim_serve_2() {
     assert_eq!(s.triggers, m.triggers, "every trigger heard");
     assert_eq!(m.answers, m.triggers, "every trigger answered");
     assert_eq!(s.answers, m.answers, "every answer confirmed and heard");
-    let _ = WAIT;
     drop(links);
     server.interrupt();
 }

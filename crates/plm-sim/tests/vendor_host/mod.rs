@@ -381,6 +381,19 @@ impl VendorHost {
         }
     }
 
+    /// Receives with a more lenient T_IC (a host behind a TCP bridge, whose
+    /// bytes come in bursts as the processes on both ends are scheduled).
+    pub fn set_receive_tic(&mut self, t_ic: Duration) {
+        let mut c = self.engine.config();
+        c.timeouts.t_ic = t_ic;
+        self.engine.set_config(c);
+    }
+
+    /// Whether the modem is configured for the demo.
+    pub fn configured(&self) -> bool {
+        self.configured
+    }
+
     /// Sends no new trigger from now on: what is under way finishes.
     pub fn stop(&mut self) {
         self.stopped = true;
