@@ -65,6 +65,20 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
+            name: "plm sim: T_REQ to status message through RFC 2217 on loopback (native)",
+            sources: &["crates/plm-cli/examples/bench_sim_latency.rs"],
+            cmd: Cmd::new("cargo").args([
+                "run",
+                "--profile",
+                "bench-native",
+                "-p",
+                "plm-cli",
+                "--example",
+                "bench_sim_latency",
+            ]),
+            needs_dist: false,
+        },
+        Bench {
             name:
                 "console in Chromium: ACK latency, MIB-read rate, Street view with 500 lamps, size",
             sources: &["tests/e2e/bench.mjs"],

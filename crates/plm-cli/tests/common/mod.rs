@@ -10,6 +10,8 @@
 // Each test file uses part of this module.
 #![allow(dead_code, unused_imports)]
 
+pub mod latency;
+
 pub use plm_cli::rfc2217::client::{com_port, Client, Telnet};
 pub use plm_cli::rfc2217::control::{RTS_OFF, RTS_ON};
 pub use plm_cli::rfc2217::escape;

@@ -1,0 +1,346 @@
+//! The loop of `plm sim`: one thread owns the simulation and wakes only
+//! when something happens, either a message from the sockets' threads
+//! (a connection accepted, bytes read, a connection closed, Ctrl-C) or
+//! the simulation's next deadline ([`Sim::next_deadline`]: a byte
+//! reaching a host, a modem timer, a line event), so that a modem's
+//! bytes reach its client when the simulated chip sends them (issue 13,
+//! point 8), and nothing runs while nothing happens.
+//!
+//! Each listener has a thread blocked in `accept`, each client a thread
+//! blocked in `read`; they pass what they get through one channel, whose
+//! timed wait (unlike a socket's read timeout, rounded to the kernel's
+//! scheduler tick) ends within some tens of microseconds of the deadline.
+
+use crate::rfc2217::{self, Action};
+use plm_sim::{Fault, Sim};
+use std::io::{ErrorKind, Read, Write};
+use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
+use std::time::{Duration, Instant};
+
+/// Baud rates the BR0/BR1 pins select (UM0932 3.1).
+pub const RATES: &[u32] = &plm_sim::BAUD_RATES;
+
+/// What wakes the loop.
+enum Wake {
+    /// A client connected to node `node`'s port.
+    Accepted {
+        node: usize,
+        stream: TcpStream,
+        peer: SocketAddr,
+    },
+    /// Bytes from connection `conn`.
+    Data { conn: u64, bytes: Vec<u8> },
+    /// Connection `conn` closed or failed.
+    Closed { conn: u64, why: String },
+    /// Ctrl-C, SIGTERM or [`Stopper::stop`].
+    Stop,
+}
+
+/// Stops a running [`Served`] loop from another thread.
+#[derive(Clone)]
+pub struct Stopper(Sender<Wake>);
+
+impl Stopper {
+    pub fn stop(&self) {
+        let _ = self.0.send(Wake::Stop);
+    }
+}
+
+/// The simulation and its ports, served until stopped.
+pub struct Served {
+    sim: Sim,
+    greeting: &'static str,
+    wakes: Receiver<Wake>,
+    sender: Sender<Wake>,
+    clients: Vec<Option<Client>>,
+    /// Wall-clock time of simulated time 0: when the first client came.
+    origin: Option<Instant>,
+    /// Connections so far (each client's id).
+    conns: u64,
+}
+
+impl Served {
+    /// Starts a thread accepting on each of `listeners` (node i on the
+    /// i-th); nothing is served until [`Served::run`].
+    pub fn new(sim: Sim, listeners: Vec<TcpListener>, greeting: &'static str) -> Served {
+        let (sender, wakes) = channel();
+        let clients = (0..listeners.len()).map(|_| None).collect();
+        for (node, listener) in listeners.into_iter().enumerate() {
+            let tx = sender.clone();
+            std::thread::spawn(move || accept(node, listener, tx));
+        }
+        Served {
+            sim,
+            greeting,
+            wakes,
+            sender,
+            clients,
+            origin: None,
+            conns: 0,
+        }
+    }
+
+    /// What stops [`Served::run`].
+    pub fn stopper(&self) -> Stopper {
+        Stopper(self.sender.clone())
+    }
+
+    /// Serves until stopped; then closes every client.
+    pub fn run(mut self) {
+        loop {
+            let wake = match self.deadline() {
+                Some(at) => {
+                    match self
+                        .wakes
+                        .recv_timeout(at.saturating_duration_since(Instant::now()))
+                    {
+                        Ok(w) => Some(w),
+                        Err(RecvTimeoutError::Timeout) => None,
+                        Err(RecvTimeoutError::Disconnected) => break,
+                    }
+                }
+                None => match self.wakes.recv() {
+                    Ok(w) => Some(w),
+                    Err(_) => break,
+                },
+            };
+            match wake {
+                Some(Wake::Stop) => break,
+                Some(w) => self.handle(w),
+                None => {}
+            }
+            self.advance();
+            self.forward();
+        }
+        for c in self.clients.into_iter().flatten() {
+            let _ = c.stream.shutdown(Shutdown::Both);
+            println!("plm sim: client {} disconnected (stopping)", c.peer);
+        }
+    }
+
+    /// When the simulation next needs running, on the wall clock.
+    fn deadline(&self) -> Option<Instant> {
+        let origin = self.origin?;
+        let at = self.sim.next_deadline()?;
+        Some(origin + Duration::from_micros(at))
+    }
+
+    /// Runs the simulation up to now.
+    fn advance(&mut self) {
+        if let Some(origin) = self.origin {
+            self.sim.advance_to(origin.elapsed().as_micros() as u64);
+        }
+    }
+
+    fn handle(&mut self, wake: Wake) {
+        match wake {
+            Wake::Accepted { node, stream, peer } => self.accepted(node, stream, peer),
+            Wake::Data { conn, bytes } => {
+                let Some(node) = self.node_of(conn) else {
+                    return; // a client already dropped
+                };
+                // The bytes arrived now: bring the modems up to now first.
+                self.advance();
+                let c = self.clients[node].as_mut().expect("node_of");
+                if let Err(e) = c.receive(&mut self.sim, node, &bytes) {
+                    self.drop_client(node, &e.to_string());
+                }
+            }
+            Wake::Closed { conn, why } => {
+                if let Some(node) = self.node_of(conn) {
+                    self.drop_client(node, &why);
+                }
+            }
+            Wake::Stop => {}
+        }
+    }
+
+    fn node_of(&self, conn: u64) -> Option<usize> {
+        self.clients
+            .iter()
+            .position(|c| c.as_ref().is_some_and(|c| c.conn == conn))
+    }
+
+    fn accepted(&mut self, node: usize, stream: TcpStream, peer: SocketAddr) {
+        if self.clients[node].is_some() {
+            return refuse(stream, peer);
+        }
+        // The modems power on with the first client (simulated time 0).
+        self.origin.get_or_insert_with(Instant::now);
+        self.advance();
+        self.conns += 1;
+        let conn = self.conns;
+        let opened = Client::open(stream, peer, conn, self.sim.baud_of(node), self.greeting)
+            .and_then(|c| {
+                let reader = c.stream.try_clone()?;
+                let tx = self.sender.clone();
+                std::thread::spawn(move || read(conn, reader, tx));
+                Ok(c)
+            });
+        match opened {
+            Ok(c) => {
+                if self.clients.len() > 1 {
+                    println!("plm sim: client {peer} connected to node {node}");
+                } else {
+                    println!("plm sim: client {peer} connected");
+                }
+                self.clients[node] = Some(c);
+            }
+            Err(e) => println!("plm sim: client {peer} lost at once: {e}"),
+        }
+    }
+
+    /// Passes what reached each served host to its client (lost when
+    /// nobody is connected: nobody is on the host side of that UART).
+    fn forward(&mut self) {
+        for node in 0..self.clients.len() {
+            let out: Vec<u8> = self
+                .sim
+                .host_read_of(node)
+                .into_iter()
+                .map(|(_, b)| b)
+                .collect();
+            let Some(c) = self.clients[node].as_mut() else {
+                continue;
+            };
+            if let Err(e) = c.send(&out) {
+                self.drop_client(node, &e.to_string());
+            }
+        }
+    }
+
+    fn drop_client(&mut self, node: usize, why: &str) {
+        let Some(c) = self.clients[node].take() else {
+            return;
+        };
+        let _ = c.stream.shutdown(Shutdown::Both);
+        println!("plm sim: client {} disconnected ({why})", c.peer);
+        self.advance();
+        // The host is gone: T_REQ and DTR are released (pulled up).
+        self.sim.set_treq_of(node, false);
+        self.sim.inject_on(node, Fault::Resetn(false));
+    }
+}
+
+/// A listener's thread: every connection to the loop.
+fn accept(node: usize, listener: TcpListener, tx: Sender<Wake>) {
+    for conn in listener.incoming() {
+        let sent = match conn.and_then(|s| Ok((s.peer_addr()?, s))) {
+            Ok((peer, stream)) => tx.send(Wake::Accepted { node, stream, peer }),
+            Err(e) => {
+                eprintln!("plm sim: accept failed: {e}");
+                Ok(())
+            }
+        };
+        if sent.is_err() {
+            return; // the loop has ended
+        }
+    }
+}
+
+/// A client's thread: its bytes to the loop as they come.
+fn read(conn: u64, mut stream: TcpStream, tx: Sender<Wake>) {
+    let mut buf = [0u8; 4096];
+    let why = loop {
+        match stream.read(&mut buf) {
+            Ok(0) => break "closed by the client".to_string(),
+            Ok(n) => {
+                let bytes = buf[..n].to_vec();
+                if tx.send(Wake::Data { conn, bytes }).is_err() {
+                    return;
+                }
+            }
+            Err(e) if e.kind() == ErrorKind::Interrupted => {}
+            Err(e) => break e.to_string(),
+        }
+    };
+    let _ = tx.send(Wake::Closed { conn, why });
+}
+
+/// A second client while one is connected: told and closed.
+fn refuse(mut stream: TcpStream, peer: SocketAddr) {
+    println!("plm sim: refused {peer}: a client is already connected");
+    let _ = stream.write_all(b"plm sim: busy: the simulated modem has a client already\r\n");
+    let _ = stream.shutdown(Shutdown::Both);
+}
+
+/// A connected client.
+struct Client {
+    stream: TcpStream,
+    peer: SocketAddr,
+    conn: u64,
+    telnet: rfc2217::Server,
+    /// Modem bytes held while the client has suspended the flow
+    /// (RFC 2217 FLOWCONTROL-SUSPEND).
+    held: Vec<u8>,
+}
+
+impl Client {
+    fn open(
+        stream: TcpStream,
+        peer: SocketAddr,
+        conn: u64,
+        baud: u32,
+        greeting: &'static str,
+    ) -> std::io::Result<Client> {
+        stream.set_nonblocking(false)?;
+        // Bytes go out as they come: Nagle's delay would eat T_ACK (40 ms).
+        stream.set_nodelay(true)?;
+        stream.set_write_timeout(Some(Duration::from_secs(5)))?;
+        let mut c = Client {
+            stream,
+            peer,
+            conn,
+            telnet: rfc2217::Server::new(greeting, baud, RATES),
+            held: Vec::new(),
+        };
+        let greeting = c.telnet.greeting();
+        c.stream.write_all(&greeting)?;
+        Ok(c)
+    }
+
+    /// Sends modem bytes to the client, IAC doubled (RFC 2217 "Data
+    /// transfer": the data stream is Telnet, RFC 854).
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.held.extend_from_slice(bytes);
+        if self.telnet.suspended() || self.held.is_empty() {
+            return Ok(());
+        }
+        let data = rfc2217::escape(&self.held);
+        self.held.clear();
+        self.stream.write_all(&data)
+    }
+
+    /// Carries out what the client sent:
+    ///
+    /// | client (RFC 2217)                    | simulated modem `node`     |
+    /// |--------------------------------------|----------------------------|
+    /// | data                                 | host UART TX -> modem RX   |
+    /// | SET-BAUDRATE 9600/19200/38400/57600  | BR pins (`Sim::set_baud_of`) |
+    /// | SET-CONTROL RTS ON / OFF             | T_REQ asserted / released  |
+    /// | SET-CONTROL DTR ON / OFF             | RESETN held low / released |
+    fn receive(&mut self, sim: &mut Sim, node: usize, bytes: &[u8]) -> std::io::Result<()> {
+        let mut reply = Vec::new();
+        for action in self.telnet.receive(bytes, &mut reply) {
+            match action {
+                Action::Write(data) => sim.write_to(node, &data),
+                Action::SetBaud(baud) => sim.set_baud_of(node, baud),
+                Action::SetRts(on) => sim.set_treq_of(node, on),
+                // DTR wired to RESETN, as on many USB-UART boards: asserted
+                // holds the modem in reset, released boots it.
+                Action::SetDtr(on) => sim.inject_on(node, Fault::Resetn(on)),
+                Action::PurgeReceive => {
+                    self.held.clear();
+                    sim.host_read_of(node);
+                }
+                // Client data goes to the UART at once: nothing is held.
+                Action::PurgeTransmit => {}
+                Action::Suspend(_) => {}
+            }
+        }
+        self.stream.write_all(&reply)?;
+        // Resuming sends what was held.
+        self.send(&[])
+    }
+}
