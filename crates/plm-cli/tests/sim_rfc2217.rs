@@ -374,8 +374,16 @@ fn serve_2_serves_two_modems_of_one_line_each_on_its_own_port() {
         "{peers}"
     );
     let mut clients: Vec<Client> = addrs.iter().map(|a| Client::connect(a)).collect();
+    // Each port has its own accepting thread: the lines come in any order.
+    let mut said: Vec<String> = (0..2)
+        .map(|_| server.line_containing("connected to node"))
+        .collect();
+    said.sort_by_key(|l| l.chars().last());
+    assert!(
+        said[0].ends_with("node 0") && said[1].ends_with("node 1"),
+        "{said:?}"
+    );
     for (i, c) in clients.iter_mut().enumerate() {
-        server.line_containing(&format!("connected to node {i}"));
         c.send(&[IAC, WILL, COM_PORT]);
         c.expect_telnet("DO COM-PORT-OPTION", |t| {
             *t == Telnet::Negotiation(DO, COM_PORT)
@@ -414,8 +422,15 @@ fn serve_on_a_fixed_port_takes_the_ports_above_it() {
         }
     };
     let listen = format!("127.0.0.1:{base}");
-    let mut server = Server::start(&["--listen", &listen, "--serve", "2", "--peers", "factory"]);
+    let mut server = Server::start(&[
+        "--listen", &listen, "--serve", "2", "--nodes", "3", "--peers", "factory",
+    ]);
     let addrs = node_addrs(&mut server, 2);
+    let peers = server.line_containing("echo what they hear");
+    assert!(
+        peers.contains("nodes 2-2") && peers.contains("factory MIB"),
+        "{peers}"
+    );
     assert_eq!(
         addrs,
         [
