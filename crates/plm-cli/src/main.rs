@@ -102,21 +102,23 @@ struct SimArgs {
     /// authentication).
     #[arg(long)]
     allow_remote: bool,
-    /// Modems on the simulated power line: the served one and N-1 others
-    /// that echo what they hear.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
-    nodes: u16,
+    /// Modems on the simulated power line (1-64, default: as many as
+    /// served): the served ones and the others, which echo what they
+    /// hear.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
+    nodes: Option<u16>,
     /// Serve nodes 0..N-1 of the line, each on its own RFC 2217 port
     /// (the --listen port + i; port 0: N free ports), each with its own
-    /// client, T_REQ, baud rate and faults (--nodes grows to N at least).
+    /// client, T_REQ, DTR, baud rate and faults (1-64, default 1).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
     serve: u16,
     /// The MIB of the nodes that are not served (they echo what they
     /// hear): `follow` applies node 0's MIB 00h/01h values as its host
-    /// writes them, so that they hear what node 0 sends; `factory` keeps
-    /// the factory MIB.
-    #[arg(long, value_enum, default_value_t = PeerMib::Follow)]
-    peers: PeerMib,
+    /// writes them, so that they hear what node 0 sends (the default);
+    /// `factory` keeps the factory MIB. Needs such nodes (--nodes above
+    /// --serve).
+    #[arg(long, value_enum, conflicts_with_all = ["street", "board"])]
+    peers: Option<PeerMib>,
     /// Serve a street-light concentrator board's USART (application
     /// frames, no T_REQ) with a street of lamps behind it (12 unless
     /// --street says otherwise).
@@ -215,14 +217,31 @@ fn sim(args: SimArgs) -> Result<(), String> {
             "--cold-lamps and --lamp-failures need a street of lamps: add --street N or --board"
                 .into(),
         ),
-        (false, None) => sim_server::World::Modems {
-            nodes: args.nodes.into(),
-            serve: args.serve.into(),
-            peers: match args.peers {
-                PeerMib::Follow => plm_sim::Peers::EchoFollowing,
-                PeerMib::Factory => plm_sim::Peers::Echo,
-            },
-        },
+        (false, None) => {
+            let nodes = args.nodes.unwrap_or(args.serve);
+            if nodes < args.serve {
+                return Err(format!(
+                    "--nodes {nodes} --serve {}: the served nodes are nodes of the line; \
+                     give --nodes {} or more",
+                    args.serve, args.serve
+                ));
+            }
+            if nodes == args.serve && args.peers.is_some() {
+                return Err(format!(
+                    "--peers: every node is served ({nodes}), none echoes; \
+                     add nodes that do with --nodes {} or more",
+                    args.serve + 1
+                ));
+            }
+            sim_server::World::Modems {
+                nodes: nodes.into(),
+                serve: args.serve.into(),
+                peers: match args.peers.unwrap_or(PeerMib::Follow) {
+                    PeerMib::Follow => plm_sim::Peers::EchoFollowing,
+                    PeerMib::Factory => plm_sim::Peers::Echo,
+                },
+            }
+        }
     };
     sim_server::run(sim_server::Options {
         listen: args.listen,
