@@ -10,7 +10,8 @@
 mod common;
 
 use common::{
-    com_port, Link, Server, Telnet, BINARY, COM_PORT, DO, DONT, IAC, SGA, WAIT, WILL, WONT,
+    com_port, Link, Server, Telnet, BINARY, COM_PORT, DO, DONT, DTR_OFF, DTR_ON, IAC, RTS_OFF,
+    RTS_ON, SET_CONTROL, SGA, WAIT, WILL, WONT,
 };
 use plm_core::link::{checksum, Dialect, Element, LocalFrame, Source, StreamDecoder, Stx};
 use std::collections::VecDeque;
@@ -115,10 +116,19 @@ impl Client {
         }
     }
 
+    /// RTS (T_REQ) through the client's SET-CONTROL, answered in kind.
     fn set_rts(&mut self, on: bool) {
-        let value = if on { 11 } else { 12 };
-        self.send(&com_port(5, &[value]));
-        assert_eq!(self.expect_reply(5), [value], "RTS reply");
+        self.link.set_rts(on).unwrap();
+        let value = if on { RTS_ON } else { RTS_OFF };
+        assert_eq!(self.expect_reply(SET_CONTROL), [value], "RTS reply");
+    }
+
+    /// DTR (RESETN in `plm sim`) through the client's SET-CONTROL,
+    /// answered in kind.
+    fn set_dtr(&mut self, on: bool) {
+        self.link.set_dtr(on).unwrap();
+        let value = if on { DTR_ON } else { DTR_OFF };
+        assert_eq!(self.expect_reply(SET_CONTROL), [value], "DTR reply");
     }
 
     /// T_REQ asserted, the status message awaited, `frame` sent with T_REQ
@@ -130,10 +140,10 @@ impl Client {
             other => panic!("expected the status message, got {other:?}"),
         }
         let mut out = vec![frame[0]];
-        out.extend(com_port(5, &[12]));
+        out.extend(com_port(SET_CONTROL, &[RTS_OFF]));
         out.extend(common::escape(&frame[1..]));
         self.send(&out);
-        assert_eq!(self.expect_reply(5), [12], "RTS OFF reply");
+        assert_eq!(self.expect_reply(SET_CONTROL), [RTS_OFF], "RTS OFF reply");
     }
 }
 
@@ -313,8 +323,7 @@ fn a_dtr_pulse_resets_the_modem_to_its_factory_mib() {
 
     // DTR asserted (RFC 2217 SET-CONTROL 8): RESETN held low, the modem
     // is off and answers nothing, not even T_REQ.
-    c.send(&com_port(5, &[8]));
-    assert_eq!(c.expect_reply(5), [8], "DTR ON reply");
+    c.set_dtr(true);
     c.set_rts(true);
     let quiet_until = Instant::now() + Duration::from_millis(400);
     while Instant::now() < quiet_until {
@@ -328,8 +337,7 @@ fn a_dtr_pulse_resets_the_modem_to_its_factory_mib() {
     c.set_rts(false);
 
     // DTR released (SET-CONTROL 9): the modem boots as at power-on.
-    c.send(&com_port(5, &[9]));
-    assert_eq!(c.expect_reply(5), [9], "DTR OFF reply");
+    c.set_dtr(false);
     let reset = c.next_frame();
     assert_eq!(reset.code, 0x3E, "BIO_ResetIndication after DTR: {reset:?}");
     // Table 19: cause 0 (power-on / RESETN), every object at its default.

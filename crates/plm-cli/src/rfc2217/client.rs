@@ -14,7 +14,8 @@
 //!   agreed (BINARY, SUPPRESS-GO-AHEAD, COM-PORT-OPTION), the port set to
 //!   a baud rate and 8N1, RTS off; then [`Client::read_data`] and
 //!   [`Client::send_data`] move serial data (IAC doubled, RFC 854) and
-//!   [`Client::set_rts`] drives RTS (SET-CONTROL 11/12).
+//!   [`Client::set_rts`] drives RTS (SET-CONTROL 11/12), [`Client::set_dtr`]
+//!   DTR (SET-CONTROL 8/9).
 
 use super::{
     cmd, control, escape, BINARY, COM_PORT_OPTION, DO, DONT, IAC, SB, SE, SGA, WILL, WONT,
@@ -242,6 +243,19 @@ impl Client {
             control::RTS_ON
         } else {
             control::RTS_OFF
+        };
+        self.send(&com_port(cmd::SET_CONTROL, &[value]))
+    }
+
+    /// Sets DTR (SET-CONTROL 8 on, 9 off): on a port whose DTR is wired
+    /// to the modem's RESETN (`plm sim`, many USB-UART boards), on holds
+    /// the modem in reset and off lets it boot. The server's answer is
+    /// taken by a later read.
+    pub fn set_dtr(&mut self, on: bool) -> io::Result<()> {
+        let value = if on {
+            control::DTR_ON
+        } else {
+            control::DTR_OFF
         };
         self.send(&com_port(cmd::SET_CONTROL, &[value]))
     }
@@ -497,6 +511,24 @@ mod tests {
         // DO BINARY answered our WILL: nothing; WILL SGA: DO SGA once;
         // DO ECHO: WONT ECHO.
         assert_eq!(got, [IAC, DO, SGA, IAC, WONT, 1]);
+    }
+
+    /// RTS and DTR as RFC 2217 SET-CONTROL (command 5) values: RTS
+    /// 11/12, DTR 8/9.
+    #[test]
+    fn rts_and_dtr_are_set_control_commands() {
+        let (mut c, mut server) = pair();
+        c.set_dtr(true).unwrap();
+        c.set_dtr(false).unwrap();
+        c.set_rts(true).unwrap();
+        c.set_rts(false).unwrap();
+        let mut got = vec![0u8; 4 * 7];
+        server.read_exact(&mut got).unwrap();
+        let want: Vec<u8> = [8, 9, 11, 12]
+            .iter()
+            .flat_map(|&v| [IAC, SB, COM_PORT_OPTION, 5, v, IAC, SE])
+            .collect();
+        assert_eq!(got, want);
     }
 
     #[test]

@@ -13,7 +13,7 @@
 pub mod latency;
 
 pub use plm_cli::rfc2217::client::{com_port, Client, Telnet};
-pub use plm_cli::rfc2217::control::{RTS_OFF, RTS_ON};
+pub use plm_cli::rfc2217::control::{DTR_OFF, DTR_ON, RTS_OFF, RTS_ON};
 pub use plm_cli::rfc2217::escape;
 pub use plm_cli::rfc2217::{BINARY, DO, DONT, IAC, SGA, WILL, WONT};
 use std::io::{BufRead, BufReader, Write};
