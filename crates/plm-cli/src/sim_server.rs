@@ -181,12 +181,14 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             banner.push(format!("plm sim: node {i} on rfc2217://{a}"));
         }
     }
-    if sim.nodes() > serve {
+    // A street's other nodes are street-light boards (named above), not
+    // echoing modems.
+    if let (World::Modems { peers, .. }, true) = (&opts.world, sim.nodes() > serve) {
         banner.push(format!(
             "plm sim: nodes {}-{} echo what they hear, {}",
             serve,
             sim.nodes() - 1,
-            match sim_peers(&opts.world) {
+            match peers {
                 Peers::EchoFollowing => "with node 0's MIB 00h/01h (as its host writes them)",
                 _ => "with the factory MIB (--peers factory)",
             }
@@ -200,14 +202,6 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         banner,
         served: Served::new(sim, listeners, greeting),
     })
-}
-
-/// Who the echoing peers of `world` are.
-fn sim_peers(world: &World) -> Peers {
-    match world {
-        World::Modems { peers, .. } => *peers,
-        World::Street { .. } => Peers::Street,
-    }
 }
 
 /// Binds `n` ports: `listen`, then its port + 1, ... (port 0: `n` free

@@ -434,3 +434,25 @@ fn lamp_failures_need_a_street_and_a_rate() {
     assert_eq!(code, Some(2));
     assert!(err.contains("0 to 60"), "{err}");
 }
+
+/// The start-up lines of a street name its boards, and say nothing of
+/// echoing peers (a street has none; `--peers` is refused with it).
+#[test]
+fn a_street_is_announced_as_boards_not_echoing_peers() {
+    for (args, what) in [
+        (
+            &["--street", "3"][..],
+            "simulated ST7580 with a street of 3 lamps (nodes 1-3",
+        ),
+        (
+            &["--board"],
+            "concentrator board's USART with a street of 12 lamps (nodes 1-12",
+        ),
+    ] {
+        let mut server = Server::start(&[args, &["--listen", "127.0.0.1:0"]].concat());
+        assert!(server.banner.contains(what), "{}", server.banner);
+        let lines = server.lines_up_to("powers on");
+        assert!(!lines.iter().any(|l| l.contains("echo")), "{lines:?}");
+        server.interrupt();
+    }
+}

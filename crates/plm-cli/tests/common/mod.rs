@@ -91,6 +91,25 @@ impl Server {
         }
     }
 
+    /// The lines up to the first containing `text`, that one included.
+    pub fn lines_up_to(&mut self, text: &str) -> Vec<String> {
+        let deadline = Instant::now() + WAIT;
+        let mut lines = Vec::new();
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) => {
+                    let last = line.contains(text);
+                    lines.push(line);
+                    if last {
+                        return lines;
+                    }
+                }
+                Err(e) => panic!("no line with {text:?} from plm sim after {lines:?}: {e}"),
+            }
+        }
+    }
+
     /// The lines printed so far and not yet looked at (no waiting).
     pub fn lines_so_far(&mut self) -> Vec<String> {
         self.lines.try_iter().collect()
