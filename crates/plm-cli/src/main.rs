@@ -28,7 +28,8 @@ enum Command {
     /// of garbage; with --chip st7570 --line, a frame from the power line.
     Decode(DecodeArgs),
     /// Serve a simulated modem as an RFC 2217 (Telnet COM-PORT-OPTION)
-    /// serial port: RTS drives T_REQ, SET-BAUDRATE the BR pins.
+    /// serial port: RTS drives T_REQ, DTR RESETN, SET-BAUDRATE the BR
+    /// pins.
     Sim(SimArgs),
     /// Talk to street-light controller boards through a concentrator
     /// board or a bare ST7580 on a serial device or an rfc2217:// port:
@@ -91,7 +92,7 @@ struct DecodeArgs {
 
 #[derive(clap::Args)]
 struct SimArgs {
-    /// Which chip to simulate (only the ST7580 so far).
+    /// Which chip to simulate (only the ST7580 so far: st7570 is refused).
     #[arg(long, value_enum, default_value = "st7580")]
     chip: Chip,
     /// Address to listen on; port 0 picks a free port (the one chosen is
@@ -104,19 +105,20 @@ struct SimArgs {
     allow_remote: bool,
     /// Modems on the simulated power line (1-64, default: as many as
     /// served): the served ones and the others, which echo what they
-    /// hear.
+    /// hear. Not with --street or --board.
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
     nodes: Option<u16>,
     /// Serve nodes 0..N-1 of the line, each on its own RFC 2217 port
     /// (the --listen port + i; port 0: N free ports), each with its own
-    /// client, T_REQ, DTR, baud rate and faults (1-64, default 1).
+    /// client, T_REQ, DTR and baud rate (1-64). Not with --street or
+    /// --board.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
     serve: u16,
     /// The MIB of the nodes that are not served (they echo what they
     /// hear): `follow` applies node 0's MIB 00h/01h values as its host
     /// writes them, so that they hear what node 0 sends (the default);
     /// `factory` keeps the factory MIB. Needs such nodes (--nodes above
-    /// --serve).
+    /// --serve); not with --street or --board.
     #[arg(long, value_enum, conflicts_with_all = ["street", "board"])]
     peers: Option<PeerMib>,
     /// Serve a street-light concentrator board's USART (application
@@ -124,8 +126,9 @@ struct SimArgs {
     /// --street says otherwise).
     #[arg(long)]
     board: bool,
-    /// Put a street of N street-light boards on the power line, behind
-    /// the served modem (or the concentrator board with --board).
+    /// Put a street of N street-light boards (1-500) on the power line,
+    /// nodes 1..N, behind the served modem (node 0; or the concentrator
+    /// board with --board).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=500))]
     street: Option<u16>,
     /// The street's lamps start cold when the simulation powers on:

@@ -163,10 +163,13 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             },
         ),
     };
-    let greeting = match config.attach {
-        Attach::Modem => "plm sim: simulated ST7580, node 0",
-        Attach::Board => "plm sim: simulated street-light concentrator board (USART)",
-    };
+    // What each port answers to RFC 2217 SIGNATURE.
+    let signatures = (0..serve)
+        .map(|node| match config.attach {
+            Attach::Modem => format!("plm sim: simulated ST7580, node {node}"),
+            Attach::Board => "plm sim: simulated street-light concentrator board (USART)".into(),
+        })
+        .collect();
     let sim = Sim::new(SimConfig {
         seed: opts.seed,
         ..config
@@ -200,7 +203,7 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
     Ok(Bound {
         addrs,
         banner,
-        served: Served::new(sim, listeners, greeting),
+        served: Served::new(sim, listeners, signatures),
     })
 }
 

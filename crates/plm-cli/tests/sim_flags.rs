@@ -83,3 +83,68 @@ fn fewer_nodes_than_served_are_refused() {
         "{err}"
     );
 }
+
+/// docs/cli.md's `plm sim` section and `plm sim --help` name the same
+/// options, each with the same range or values where the help gives one.
+#[test]
+fn docs_and_help_name_the_same_options() {
+    let out = Command::new(env!("CARGO_BIN_EXE_plm"))
+        .args(["sim", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8(out.stdout).unwrap();
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/cli.md")).unwrap();
+    let section = docs
+        .split("\n# `plm sim`")
+        .nth(1)
+        .expect("docs/cli.md has a `plm sim` section")
+        .split("\n# ")
+        .next()
+        .unwrap();
+    // An option of the help is a line starting with `--name` (after
+    // `-h, ` for help itself).
+    let in_help: Vec<&str> = help
+        .lines()
+        .filter_map(|l| l.trim_start().strip_prefix("--"))
+        .filter_map(|l| l.split([' ', '<']).next())
+        .filter(|name| *name != "help")
+        .collect();
+    assert!(in_help.len() >= 11, "{in_help:?}");
+    // An option of the docs is a list item starting with `` `--name ``.
+    let in_docs: Vec<&str> = section
+        .lines()
+        .filter_map(|l| l.strip_prefix("- `--"))
+        .filter_map(|l| l.split([' ', '`']).next())
+        .collect();
+    let mut a = in_help.clone();
+    let mut b = in_docs.clone();
+    a.sort();
+    b.sort();
+    assert_eq!(a, b, "options of plm sim --help, then of docs/cli.md");
+    for (name, words) in [
+        ("serve", "1-64"),
+        ("nodes", "1-64"),
+        ("street", "1-500"),
+        ("lamp-failures", "0-60"),
+        ("peers", "follow|factory"),
+        ("listen", "127.0.0.1:7580"),
+    ] {
+        let item = section
+            .split(&format!("\n- `--{name}"))
+            .nth(1)
+            .unwrap_or_else(|| panic!("--{name} in the docs"));
+        let item = item.split("\n- ").next().unwrap();
+        assert!(item.contains(words), "docs, --{name}: {item}");
+        let entry = help
+            .split("\n      --")
+            .find(|e| {
+                e.strip_prefix(name)
+                    .is_some_and(|r| r.starts_with([' ', '\n']))
+            })
+            .unwrap_or_else(|| panic!("--{name} in the help"));
+        for word in words.split('|') {
+            assert!(entry.contains(word), "help, --{name}: {entry}");
+        }
+    }
+}

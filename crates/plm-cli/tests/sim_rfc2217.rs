@@ -399,6 +399,12 @@ fn serve_2_serves_two_modems_of_one_line_each_on_its_own_port() {
         c.set_rts(false);
         assert_eq!(c.next_frame().code, 0x3E, "node {i}: BIO_ResetIndication");
     }
+    // Each port names its node (RFC 2217 SIGNATURE, asked empty).
+    for (i, c) in clients.iter_mut().enumerate() {
+        c.send(&com_port(0, &[]));
+        let said = String::from_utf8(c.expect_reply(0)).unwrap();
+        assert!(said.ends_with(&format!("node {i}")), "{said}");
+    }
     // Each its own modem: node 1 configured otherwise, node 0 untouched.
     let write = frame(0x08, &[0x00, 0x10]);
     assert_eq!(ask(&mut clients[1], &write).code, 0x09);

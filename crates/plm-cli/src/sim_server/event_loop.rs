@@ -50,7 +50,8 @@ impl Stopper {
 /// The simulation and its ports, served until stopped.
 pub struct Served {
     sim: Sim,
-    greeting: &'static str,
+    /// Each node's answer to RFC 2217 SIGNATURE.
+    signatures: Vec<String>,
     wakes: Receiver<Wake>,
     sender: Sender<Wake>,
     clients: Vec<Option<Client>>,
@@ -62,8 +63,9 @@ pub struct Served {
 
 impl Served {
     /// Starts a thread accepting on each of `listeners` (node i on the
-    /// i-th); nothing is served until [`Served::run`].
-    pub fn new(sim: Sim, listeners: Vec<TcpListener>, greeting: &'static str) -> Served {
+    /// i-th, whose RFC 2217 SIGNATURE is `signatures[i]`); nothing is
+    /// served until [`Served::run`].
+    pub fn new(sim: Sim, listeners: Vec<TcpListener>, signatures: Vec<String>) -> Served {
         let (sender, wakes) = channel();
         let clients = (0..listeners.len()).map(|_| None).collect();
         for (node, listener) in listeners.into_iter().enumerate() {
@@ -72,7 +74,7 @@ impl Served {
         }
         Served {
             sim,
-            greeting,
+            signatures,
             wakes,
             sender,
             clients,
@@ -171,8 +173,9 @@ impl Served {
         self.advance();
         self.conns += 1;
         let conn = self.conns;
-        let opened = Client::open(stream, peer, conn, self.sim.baud_of(node), self.greeting)
-            .and_then(|c| {
+        let signature = &self.signatures[node];
+        let opened =
+            Client::open(stream, peer, conn, self.sim.baud_of(node), signature).and_then(|c| {
                 let reader = c.stream.try_clone()?;
                 let tx = self.sender.clone();
                 std::thread::spawn(move || read(conn, reader, tx));
@@ -282,7 +285,7 @@ impl Client {
         peer: SocketAddr,
         conn: u64,
         baud: u32,
-        greeting: &'static str,
+        signature: &str,
     ) -> std::io::Result<Client> {
         stream.set_nonblocking(false)?;
         // Bytes go out as they come: Nagle's delay would eat T_ACK (40 ms).
@@ -292,7 +295,7 @@ impl Client {
             stream,
             peer,
             conn,
-            telnet: rfc2217::Server::new(greeting, baud, RATES),
+            telnet: rfc2217::Server::new(signature, baud, RATES),
             held: Vec::new(),
         };
         let greeting = c.telnet.greeting();
