@@ -6,7 +6,7 @@
 // - Telnet negotiation (RFC 854/855): BINARY (RFC 856) and
 //   SUPPRESS-GO-AHEAD (RFC 858) both ways, COM-PORT-OPTION (RFC 2217).
 // - SET-BAUDRATE, SET-DATASIZE, SET-PARITY, SET-STOPSIZE (8N1) and
-//   SET-CONTROL RTS ON (11) / OFF (12); the server answers each with the
+//   SET-CONTROL DTR ON (8) / OFF (9) and RTS ON (11) / OFF (12); the server answers each with the
 //   code + 100 and the value in effect.
 // - Data: IAC doubled on the way out, undoubled on the way in; Telnet
 //   commands and subnegotiations are taken out of the byte stream.
@@ -38,6 +38,8 @@ export const SET_CONTROL = 5;
 export const SERVER_OFFSET = 100;
 
 /** SET-CONTROL values. */
+export const DTR_ON = 8;
+export const DTR_OFF = 9;
 export const RTS_ON = 11;
 export const RTS_OFF = 12;
 /** SET-PARITY NONE, SET-STOPSIZE 1. */
@@ -158,7 +160,7 @@ export function comPort(code, value = []) {
 /**
  * One connection to an RFC 2217 server. Emits 'data' (Buffer of serial
  * bytes) and 'close'. `log` records what went to the port, in order:
- * {at, write: [bytes]} and {at, rts: bool}.
+ * {at, write: [bytes]}, {at, rts: bool} and {at, dtr: bool}.
  */
 export class Rfc2217Client extends EventEmitter {
   /** Connects to `host:port`, negotiates, and sets `baud` 8N1. */
@@ -292,6 +294,11 @@ export class Rfc2217Client extends EventEmitter {
   }
 
   /** SET-CONTROL RTS ON / OFF, in order with the data. */
+  setDtr(on) {
+    this.log.push({ at: performance.now(), dtr: on });
+    this.send(comPort(SET_CONTROL, [on ? DTR_ON : DTR_OFF]));
+  }
+
   setRts(on) {
     this.rts = on;
     this.log.push({ at: performance.now(), rts: on });

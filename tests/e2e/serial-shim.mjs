@@ -15,13 +15,14 @@
 //   port that is gone (NetworkError); readable and writable are real
 //   ReadableStream / WritableStream, null while closed.
 // - close() refuses while a stream is locked (TypeError).
-// - setSignals({requestToSend}) needs an open port.
+// - setSignals({requestToSend, dataTerminalReady}) needs an open port.
+//   (Unlike most operating systems, open() leaves DTR and RTS released.)
 // - Unplugging errors both streams with NetworkError, makes readable null,
 //   and fires 'disconnect' at the port, seen on navigator.serial with the
 //   port as its target (the Serial object is the port's parent).
 //
 // Bindings (Node side): __plmSerialOpen(id, options) -> true,
-// __plmSerialWrite(id, bytes), __plmSerialSignals(id, {rts}),
+// __plmSerialWrite(id, bytes), __plmSerialSignals(id, {rts} or {dtr}),
 // __plmSerialClose(id). Node delivers modem bytes with
 // window.__plmSerialShim.receive(id, bytes). Tests unplug and plug with
 // window.__plmSerialShim.unplug(id) / replug(id).
@@ -94,6 +95,7 @@
       this._open = true;
       this._rts = false;
       this._dtr = false;
+      this._asked = false;
       this.readable = new ReadableStream({
         start: (c) => {
           this._rx = c;
@@ -122,11 +124,20 @@
       if (!this._open) throw notOpen();
       if (!this._plugged) throw lost();
       if ('requestToSend' in signals) {
-        this._rts = Boolean(signals.requestToSend);
-        note(this._id, { rts: this._rts });
-        window.__plmSerialSignals(this._id, { rts: this._rts }).catch(() => {});
+        // Windows' usbser driver applies the level of the call before
+        // (window.__plmSerialQuirks.rtsLate, set by a test).
+        const asked = Boolean(signals.requestToSend);
+        const rts = window.__plmSerialQuirks?.rtsLate ? this._asked ?? false : asked;
+        this._asked = asked;
+        this._rts = rts;
+        note(this._id, { rts });
+        window.__plmSerialSignals(this._id, { rts }).catch(() => {});
       }
-      if ('dataTerminalReady' in signals) this._dtr = Boolean(signals.dataTerminalReady);
+      if ('dataTerminalReady' in signals) {
+        this._dtr = Boolean(signals.dataTerminalReady);
+        note(this._id, { dtr: this._dtr });
+        window.__plmSerialSignals(this._id, { dtr: this._dtr }).catch(() => {});
+      }
     }
 
     async getSignals() {
@@ -249,7 +260,7 @@
     },
     state(id = ADAPTERS[0].id) {
       const p = ports.get(id);
-      return { open: p._open, plugged: p._plugged, rts: p._rts ?? false };
+      return { open: p._open, plugged: p._plugged, rts: p._rts ?? false, dtr: p._dtr ?? false };
     },
   };
 })();

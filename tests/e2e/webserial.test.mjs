@@ -128,6 +128,7 @@ async function bridge(context, sim) {
   });
   await context.exposeBinding('__plmSerialSignals', (_source, _id, signals) => {
     if ('rts' in signals) wire.current?.setRts(signals.rts);
+    if ('dtr' in signals) wire.current?.setDtr(signals.dtr);
   });
   await context.exposeBinding('__plmSerialClose', (_source, _id) => {
     wire.current?.close();
@@ -352,6 +353,70 @@ test('WebSerial: the granted port and settings are remembered across a reload; b
   await page.waitForFunction(() => !window.__plmSerialShim.state().open);
   assert.equal(wire.current, null, 'the RFC 2217 connection was closed');
   await ping(page);
+});
+
+test('WebSerial: with RESETN wired to DTR (kept per port), Reset modem pulses DTR and the reset indication shows in Traffic', async (t) => {
+  const { page, wire } = await open(t);
+  await connectSerial(page);
+  await tab(page, 'diagnostics');
+  assert.ok(await page.isHidden('#reset-resetn'), 'no hardware reset until the wiring is set');
+  assert.ok(!wireLog(wire).some((e) => 'dtr' in e), 'DTR untouched while the setting is off');
+  const resets = page.locator('#traffic-table tbody tr', { hasText: 'BIO_ResetIndication' });
+  const before = await resets.count();
+  await page.check('#resetn-on-dtr');
+  // Wired: DTR is released at once (operating systems assert it on open).
+  await page.waitForFunction(() => window.__plmSerialShim.log.some((e) => e.dtr === false));
+  await page.click('#reset-resetn');
+  const deadline = Date.now() + 10_000;
+  while ((await resets.count()) <= before) {
+    assert.ok(Date.now() < deadline, 'a BIO_ResetIndication after the pulse');
+    await page.waitForTimeout(100);
+  }
+  const dtr = wireLog(wire).filter((e) => 'dtr' in e);
+  assert.deepEqual(dtr.map((e) => e.dtr), [false, true, false], 'released, then asserted and released');
+  assert.ok(dtr[2].at - dtr[1].at >= 10, `RESETN held low ${dtr[2].at - dtr[1].at} ms`);
+  await page.locator('#reset-result', { hasText: 'RESETN pulsed' }).waitFor();
+  // The reset cause the modem gives: RESETN or power-on (UM0932 Table 19).
+  await page.locator('#reset-cause', { hasText: 'RESETN' }).waitFor();
+  await shot(page, 'webserial-resetn');
+  await tab(page, 'traffic');
+  await shot(page, 'webserial-resetn-traffic');
+
+  // Kept for this port, not for the simulated modem.
+  await page.reload();
+  await page.locator('#conn-state.ok').waitFor();
+  await tab(page, 'diagnostics');
+  assert.ok(!(await page.isChecked('#resetn-on-dtr')), 'the simulated modem has its own setting');
+  await connectSerial(page, { grant: false, reset: false });
+  await tab(page, 'diagnostics');
+  await page.locator('#resetn-on-dtr:checked').waitFor();
+  assert.ok(await page.isVisible('#reset-resetn'));
+});
+
+test('WebSerial: an adapter that sets RTS one call late (Windows usbser) is told apart, and sending RTS twice fixes it', async (t) => {
+  const { page, wire } = await open(t);
+  await page.evaluate(() => {
+    window.__plmSerialQuirks = { rtsLate: true };
+  });
+  await connectSerial(page);
+  await tab(page, 'diagnostics');
+  await page.click('#ping-send');
+  // Each request loses one attempt (the modem answers the "release"),
+  // so it takes a T_SR longer; the second such request in a row is told.
+  await page.locator('#ping-result', { hasText: 'PingConfirm' }).waitFor({ timeout: 10_000 });
+  await page.click('#ping-send');
+  const advice = page.locator('#link-problem', { hasText: 'Send each RTS change twice' });
+  await advice.waitFor({ timeout: 10_000 });
+  assert.match(await advice.textContent(), /Two requests in a row had their T_REQ unanswered/);
+  await shot(page, 'webserial-rts-late');
+  await panel(page);
+  await page.check('#serial-rts-twice');
+  await page.click('#serial-connect');
+  await page.locator('#serial-panel').waitFor({ state: 'hidden' });
+  await ping(page);
+  // Remembered.
+  await panel(page);
+  assert.ok(await page.isChecked('#serial-rts-twice'));
 });
 
 test('WebSerial: a new baud rate in the connection bar reopens the port at that rate', async (t) => {

@@ -206,16 +206,21 @@ fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
     }
 }
 
-/// The last link problem, in words, until dismissed.
+/// What to do about the link (advice), else its last problem, in words,
+/// until dismissed.
 #[component]
 fn LinkProblem() -> impl IntoView {
     let console = use_console();
-    let problem = console.conn.last_problem;
+    let (problem, advice) = (console.conn.last_problem, console.conn.advice);
+    let text = move || advice.get().or_else(|| problem.get());
     view! {
-        {move || (problem.with(|p| p.is_some())).then(|| view! {
-            <div class="toast" role="status">
-                <span>{move || problem.get().unwrap_or_default()}</span>
-                <button on:click=move |_| problem.set(None)>"Dismiss"</button>
+        {move || text().map(|t| view! {
+            <div class="toast" role="status" id="link-problem">
+                <span>{t}</span>
+                <button on:click=move |_| {
+                    advice.set(None);
+                    problem.set(None);
+                }>"Dismiss"</button>
             </div>
         })}
     }

@@ -166,6 +166,10 @@ pub enum Note {
     },
     /// The host engine's timeouts changed (MIB 09h written, or reset).
     Timeouts(Timeouts),
+    /// This many requests in a row had a T_REQ assertion answered by no
+    /// status message (UM0932 3.2.8): the T_REQ line does not reach the
+    /// modem, or reaches it late.
+    TReqUnanswered(u8),
 }
 
 /// The spread of a set of durations, µs.
@@ -263,6 +267,8 @@ struct Active {
     deadline: Option<Instant>,
     /// Whether an attempt went unacknowledged (the modem may have run it).
     repeated: bool,
+    /// Whether an attempt's T_REQ got no status message.
+    unanswered: bool,
 }
 
 /// How long to wait for an answer once the modem acknowledged a request:
@@ -293,6 +299,8 @@ pub struct Session {
     /// The page's clock at the current tick, on the transport's clock.
     page_now: Instant,
     ack_times: AckTimes,
+    /// Requests in a row whose T_REQ went unanswered at least once.
+    unanswered: u8,
     out: Tick,
 }
 
@@ -311,6 +319,7 @@ impl Session {
             log_offset: 0,
             page_now: 0,
             ack_times: AckTimes::default(),
+            unanswered: 0,
             out: Tick::default(),
         }
     }
@@ -476,6 +485,7 @@ impl Session {
             submitted: now,
             deadline: None,
             repeated: false,
+            unanswered: false,
         });
     }
 
@@ -553,10 +563,14 @@ impl Session {
             Event::Repeat(_) => {}
             Event::Delivered(t) => {
                 if let Some(a) = self.active.as_mut().filter(|a| a.ticket == t) {
+                    if !a.unanswered {
+                        self.unanswered = 0;
+                    }
                     a.deadline = Some(now + answer_timeout(a.command.code()));
                 }
             }
             Event::Failed(t, cause) => {
+                self.count_unanswered(cause);
                 if self.active.as_ref().is_some_and(|a| a.ticket == t) {
                     if let Some(a) = self.active.take() {
                         self.out
@@ -570,6 +584,7 @@ impl Session {
                 attempt,
                 cause,
             } => {
+                self.count_unanswered(cause);
                 if let Some(a) = self.active.as_mut().filter(|a| a.ticket == ticket) {
                     a.repeated |= cause == LinkError::NoAck;
                 }
@@ -579,6 +594,21 @@ impl Session {
                     cause: cause.to_string(),
                 });
             }
+        }
+    }
+
+    /// Counts the requests in a row whose T_REQ got no status message at
+    /// least once: an adapter that applies RTS one call late (Windows'
+    /// usbser) makes every request lose one attempt that way, while the
+    /// modem answers the "release" that comes next.
+    fn count_unanswered(&mut self, cause: LinkError) {
+        let Some(a) = self.active.as_mut() else {
+            return;
+        };
+        if cause == LinkError::NoStatus && !a.unanswered {
+            a.unanswered = true;
+            self.unanswered = self.unanswered.saturating_add(1);
+            self.out.notes.push(Note::TReqUnanswered(self.unanswered));
         }
     }
 

@@ -4,6 +4,7 @@
 
 use crate::profile::Profile;
 use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
+use crate::storage::load;
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
@@ -24,6 +25,14 @@ pub const SIM_SEED: u64 = 7580;
 /// Line events kept for the Simulator view.
 pub const LINE_EVENTS: usize = 200;
 
+/// How long a hardware reset holds RESETN low (DTR asserted). UM0932
+/// gives no minimum; 20 ms is far beyond any reset filter.
+pub const RESETN_PULSE_MS: u64 = 20;
+
+/// What to do when T_REQ gets no status message twice in a row over
+/// WebSerial (docs/console.md, "Real adapters").
+pub const TREQ_ADVICE: &str = "Two requests in a row had their T_REQ unanswered by the modem. On Windows, the usbser driver applies each RTS change one call late (a known WebSerial issue), so T_REQ never moves when the console asks: turn on \"Send each RTS change twice\" in the WebSerial panel and connect again. Otherwise check the T_REQ wiring (RTS) and its polarity.";
+
 /// The connection bar's state.
 #[derive(Clone, Copy)]
 pub struct ConnectionStore {
@@ -43,6 +52,13 @@ pub struct ConnectionStore {
     pub retries: RwSignal<u32>,
     /// The last link problem, in words.
     pub last_problem: RwSignal<Option<String>>,
+    /// This port's DTR is wired to the modem's RESETN (a setting kept per
+    /// port, off by default): DTR is kept released and "Reset modem
+    /// (RESETN)" pulses it.
+    pub resetn_on_dtr: RwSignal<bool>,
+    /// What to do about a link that does not work, in words (shown under
+    /// the connection bar until dismissed).
+    pub advice: RwSignal<Option<String>>,
 }
 
 /// The traffic inspector's log.
@@ -200,6 +216,8 @@ pub fn provide_console() -> Console {
             timeouts: RwSignal::new(Timeouts::default()),
             retries: RwSignal::new(0),
             last_problem: RwSignal::new(None),
+            resetn_on_dtr: RwSignal::new(false),
+            advice: RwSignal::new(None),
         },
         traffic: TrafficStore {
             log: RwSignal::new(TrafficLog::default()),
@@ -339,7 +357,52 @@ impl Console {
         self.modem.status.set(None);
         self.conn.retries.set(0);
         self.conn.last_problem.set(None);
+        self.conn.advice.set(None);
         self.refresh();
+        let wired = load(&self.resetn_key()).is_some();
+        self.conn.resetn_on_dtr.set(false);
+        self.set_resetn_on_dtr(wired);
+    }
+
+    /// Where the RESETN-on-DTR setting of the port in use is kept.
+    fn resetn_key(&self) -> String {
+        let port = self.conn.port.get_untracked();
+        format!(
+            "plm-console.resetn-on-dtr.{}",
+            port.split(" (").next().unwrap_or("")
+        )
+    }
+
+    /// Says whether this port's DTR is wired to the modem's RESETN, and
+    /// remembers it for the port. Wired, DTR is released at once (the OS
+    /// asserts DTR when it opens a port, which holds such a modem in
+    /// reset).
+    pub fn set_resetn_on_dtr(&self, wired: bool) {
+        if wired && !self.conn.resetn_on_dtr.get_untracked() {
+            self.with_active(|t, _| t.map(|t| t.set_dtr(false)));
+        }
+        crate::storage::store(&self.resetn_key(), wired.then_some("1"));
+        self.conn.resetn_on_dtr.set(wired);
+        self.refresh();
+    }
+
+    /// A hardware reset: DTR (RESETN) asserted for [`RESETN_PULSE_MS`],
+    /// then released; the modem boots and sends BIO_ResetIndication
+    /// (UM0932 Table 19, cause 0).
+    pub fn pulse_resetn(&self) {
+        if !self.conn.resetn_on_dtr.get_untracked() {
+            return;
+        }
+        self.with_active(|t, _| t.map(|t| t.set_dtr(true)));
+        self.refresh();
+        let c = *self;
+        set_timeout(
+            move || {
+                c.with_active(|t, _| t.map(|t| t.set_dtr(false)));
+                c.refresh();
+            },
+            std::time::Duration::from_millis(RESETN_PULSE_MS),
+        );
     }
 
     /// Changes the profile and connects its simulated world.
@@ -564,6 +627,11 @@ impl Console {
                     self.conn.last_problem.set(Some(cause));
                 }
                 Note::Timeouts(t) => set_if_changed(self.conn.timeouts, t),
+                Note::TReqUnanswered(n) => {
+                    if n == 2 && self.conn.kind.get_untracked() == "WebSerial" {
+                        self.conn.advice.set(Some(TREQ_ADVICE.into()));
+                    }
+                }
             }
         }
         if !traffic.is_empty() {

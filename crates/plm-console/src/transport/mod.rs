@@ -53,6 +53,11 @@ pub trait Transport {
     fn write(&mut self, bytes: &[u8]);
     /// Sets T_REQ now; `asserted` means pulled low (a request to send).
     fn set_treq(&mut self, asserted: bool);
+    /// Sets DTR now (`true` = asserted). The console touches DTR only when
+    /// the port's setting says it is wired to the modem's RESETN (as on
+    /// many USB-UART boards): asserted holds the modem in reset, released
+    /// lets it boot (UM0932 Table 19, cause 0).
+    fn set_dtr(&mut self, asserted: bool);
     /// Lets time run up to `until` (no further than the clock allows) and
     /// returns the bytes received meanwhile, with their arrival times.
     fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)>;

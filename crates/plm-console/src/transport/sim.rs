@@ -89,6 +89,11 @@ impl Transport for SimTransport {
         self.sim.set_treq(asserted);
     }
 
+    /// The simulated adapter has DTR wired to RESETN (as `plm sim`).
+    fn set_dtr(&mut self, asserted: bool) {
+        self.sim.inject(Fault::Resetn(asserted));
+    }
+
     fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)> {
         self.sim.advance_to(until);
         self.sim.host_read()

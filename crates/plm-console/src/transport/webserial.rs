@@ -90,6 +90,9 @@ pub struct Settings {
     pub baud: u32,
     /// Which RTS level asserts T_REQ.
     pub polarity: TReqPolarity,
+    /// Each RTS change is sent twice: Windows' usbser driver applies the
+    /// RTS level of the call before (docs/console.md, "Real adapters").
+    pub rts_twice: bool,
 }
 
 /// Called once, with the reason in words, when the port is lost.
@@ -100,6 +103,8 @@ enum Op {
     Write(Vec<u8>),
     /// RTS level (`true` = asserted).
     Rts(bool),
+    /// DTR level (`true` = asserted).
+    Dtr(bool),
     /// Close and open the port again at this baud rate.
     Reopen(u32),
 }
@@ -119,6 +124,10 @@ struct Shared {
     generation: u32,
     /// The RTS level last asked for.
     rts: bool,
+    /// The DTR level to set, if DTR is the modem's RESETN.
+    dtr: Option<bool>,
+    /// Whether each RTS change is sent twice ([`Settings::rts_twice`]).
+    rts_twice: bool,
     /// Non-fatal receive errors (framing, parity, break, overrun) so far.
     receive_errors: u32,
     disconnect_listener: Option<Closure<dyn FnMut(web_sys::Event)>>,
@@ -215,9 +224,13 @@ async fn open_port(port: &SerialPort, baud: u32) -> Result<(), String> {
         .map_err(|e| open_error(&e))
 }
 
-async fn set_rts(port: &SerialPort, rts: bool) -> Result<(), String> {
+/// Sets RTS, and DTR when `dtr` says, in one call.
+async fn set_signals(port: &SerialPort, rts: bool, dtr: Option<bool>) -> Result<(), String> {
     let signals = SerialOutputSignals::new();
     signals.set_request_to_send(rts);
+    if let Some(dtr) = dtr {
+        signals.set_data_terminal_ready(dtr);
+    }
     port.set_signals_with_signals(&signals)
         .await
         .map(|_| ())
@@ -249,9 +262,12 @@ impl WebSerialTransport {
         closed(&port).await;
         open_port(&port, settings.baud).await?;
         // T_REQ released before anything else happens (UM0932 3.2.8: the
-        // host asserts it only to send a frame).
+        // host asserts it only to send a frame); signals can only be set
+        // once the port is open, and nothing is written before. DTR is
+        // left alone until the console says it is RESETN
+        // (`Transport::set_dtr`).
         let rts = settings.polarity.rts(false);
-        let streams = match set_rts(&port, rts).await {
+        let streams = match set_signals(&port, rts, None).await {
             Ok(()) => lock_streams(&port),
             Err(e) => Err(e),
         };
@@ -272,6 +288,8 @@ impl WebSerialTransport {
             writer: Some(writer),
             generation: 0,
             rts,
+            dtr: None,
+            rts_twice: settings.rts_twice,
             receive_errors: 0,
             disconnect_listener: None,
             on_lost: Some(on_lost),
@@ -359,6 +377,10 @@ impl Transport for WebSerialTransport {
     /// after a stall, and T_ACK is only 40 ms), and bytes that came in one
     /// chunk share one time, which only ever shortens the gaps that T_IC
     /// (UM0932 3.2.6) measures.
+    fn set_dtr(&mut self, asserted: bool) {
+        self.push(Op::Dtr(asserted));
+    }
+
     fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)> {
         let from = self.polled;
         self.polled = self.polled.max(until);
@@ -581,12 +603,27 @@ async fn carry_out(shared: &Rc<RefCell<Shared>>, op: Op) -> Result<(), String> {
                 .map_err(|e| unplugged(&format!("writing failed ({})", js_error(&e))))
         }
         Op::Rts(rts) => {
-            let port = {
+            let (port, dtr, twice) = {
                 let mut s = shared.borrow_mut();
                 s.rts = rts;
-                s.port.clone()
+                (s.port.clone(), s.dtr, s.rts_twice)
             };
-            set_rts(&port, rts).await.map_err(|e| unplugged(&e))
+            for _ in 0..1 + u8::from(twice) {
+                set_signals(&port, rts, dtr)
+                    .await
+                    .map_err(|e| unplugged(&e))?;
+            }
+            Ok(())
+        }
+        Op::Dtr(dtr) => {
+            let (port, rts) = {
+                let mut s = shared.borrow_mut();
+                s.dtr = Some(dtr);
+                (s.port.clone(), s.rts)
+            };
+            set_signals(&port, rts, Some(dtr))
+                .await
+                .map_err(|e| unplugged(&e))
         }
         Op::Reopen(baud) => reopen(shared, baud).await,
     }
@@ -595,7 +632,7 @@ async fn carry_out(shared: &Rc<RefCell<Shared>>, op: Op) -> Result<(), String> {
 /// Closes the port and opens it again at `baud` (Web Serial fixes the
 /// baud rate at `open`), keeping the RTS level.
 async fn reopen(shared: &Rc<RefCell<Shared>>, baud: u32) -> Result<(), String> {
-    let (reader, writer, port, rts, generation) = {
+    let (reader, writer, port, rts, dtr, generation) = {
         let mut s = shared.borrow_mut();
         s.generation = s.generation.wrapping_add(1);
         (
@@ -603,6 +640,7 @@ async fn reopen(shared: &Rc<RefCell<Shared>>, baud: u32) -> Result<(), String> {
             s.writer.take(),
             s.port.clone(),
             s.rts,
+            s.dtr,
             s.generation,
         )
     };
@@ -631,7 +669,7 @@ async fn reopen(shared: &Rc<RefCell<Shared>>, baud: u32) -> Result<(), String> {
         let _ = port.close().await;
         return Ok(());
     }
-    set_rts(&port, rts).await?;
+    set_signals(&port, rts, dtr).await?;
     let (reader, writer) = lock_streams(&port)?;
     {
         let mut s = shared.borrow_mut();

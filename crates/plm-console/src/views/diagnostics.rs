@@ -269,6 +269,28 @@ fn ResetCard() -> impl IntoView {
                 "BIO_ResetRequest (3Ch) restarts the modem; MIB 00h-02h survive if written since power-on (UM0932 3.3.1)."
             </p>
             <button id="reset-send" on:click=reset>"Reset modem"</button>
+            <label
+                title="Many USB-UART boards wire DTR to the modem's RESETN. Set, the console keeps DTR released and offers a hardware reset. Kept for this port."
+            >
+                <input
+                    type="checkbox"
+                    id="resetn-on-dtr"
+                    prop:checked=move || c.conn.resetn_on_dtr.get()
+                    on:change=move |ev| c.set_resetn_on_dtr(event_target_checked(&ev))
+                />
+                " RESETN wired to DTR"
+            </label>
+            <button
+                id="reset-resetn"
+                hidden=move || !c.conn.resetn_on_dtr.get()
+                title="Holds RESETN low (DTR asserted) for 20 ms: a power-on reset, factory MIB"
+                on:click=move |_| {
+                    c.pulse_resetn();
+                    message.set(Some("RESETN pulsed (DTR): the modem boots; its BIO_ResetIndication follows.".into()));
+                }
+            >
+                "Reset modem (RESETN)"
+            </button>
             <p id="reset-result">{move || message.get()}</p>
             <h4>"Last BIO_ResetIndication"</h4>
             {move || match c.modem.last_reset.get() {

@@ -46,6 +46,7 @@ mod wasm {
     const KEY_BAUD: &str = "plm-console.serial.baud";
     const KEY_POLARITY: &str = "plm-console.serial.polarity";
     const KEY_PORT: &str = "plm-console.serial.port";
+    const KEY_RTS_TWICE: &str = "plm-console.serial.rts-twice";
 
     use crate::storage::load;
 
@@ -64,6 +65,8 @@ mod wasm {
         selected: RwSignal<Option<usize>>,
         baud: RwSignal<u32>,
         polarity: RwSignal<TReqPolarity>,
+        /// Each RTS change sent twice (Windows' usbser driver).
+        rts_twice: RwSignal<bool>,
         /// A port is being opened.
         busy: RwSignal<bool>,
         message: RwSignal<Option<String>>,
@@ -159,9 +162,11 @@ mod wasm {
             let settings = Settings {
                 baud: self.baud.get_untracked(),
                 polarity: self.polarity.get_untracked(),
+                rts_twice: self.rts_twice.get_untracked(),
             };
             save(KEY_BAUD, &settings.baud.to_string());
             save(KEY_POLARITY, settings.polarity.key());
+            crate::storage::store(KEY_RTS_TWICE, settings.rts_twice.then_some("1"));
             save(KEY_PORT, &label);
             let console = self.console;
             // A port open over WebSerial now (maybe this one) is closed
@@ -251,6 +256,7 @@ mod wasm {
                     .and_then(|p| TReqPolarity::from_key(&p))
                     .unwrap_or_default(),
             ),
+            rts_twice: RwSignal::new(load(KEY_RTS_TWICE).is_some()),
             busy: RwSignal::new(false),
             message: RwSignal::new(None),
             open: RwSignal::new(false),
@@ -264,6 +270,7 @@ mod wasm {
             selected,
             baud,
             polarity,
+            rts_twice,
             busy,
             message,
             open,
@@ -373,6 +380,18 @@ mod wasm {
                     >
                         {polarities}
                     </select>
+                    <span></span>
+                    <label
+                        title="Windows' usbser driver applies the RTS level of the call before (a known WebSerial issue): T_REQ then moves one step late and the modem never answers. Sending each change twice puts it right."
+                    >
+                        <input
+                            type="checkbox"
+                            id="serial-rts-twice"
+                            prop:checked=move || rts_twice.get()
+                            on:change=move |ev| rts_twice.set(event_target_checked(&ev))
+                        />
+                        " Send each RTS change twice (Windows)"
+                    </label>
                 </div>
             }
                 .into_any()
