@@ -522,3 +522,182 @@ fn alarms_go_both_ways() {
     let rx = read(&mut net, 0, 0x0083);
     assert_eq!(u32::from_le_bytes(rx.try_into().unwrap()), 2);
 }
+
+#[test]
+fn a_360_minute_timeout_seen_in_6_minutes_at_scale_60() {
+    let mut net = Network::new(NetConfig {
+        timeout_scale: 60,
+        ..NetConfig::new(2)
+    });
+    net.run_for(10 * MS);
+    configure(&mut net, 0, mode::CLIENT, MAC);
+    configure(&mut net, 1, mode::SERVER, MAC);
+    write(&mut net, 1, 0x0001, &[0x05, 0x00, 0x00, 0x00]);
+    // 0003h 3600 s: one minute at this scale; 0004h stays 360 min.
+    write(&mut net, 1, 0x0003, &[0x10, 0x0E]);
+    find(&mut net);
+    let at = mark(&net, 1);
+    let start = net.now();
+    while syncs(&net, 1, at).is_empty() {
+        assert_eq!(confirm(&mut net, 0, mac(0, 0x0FFF, b"tick")), 0xFF);
+        net.run_for(30_000 * MS);
+        assert!(net.now() - start < 7 * 60_000 * MS);
+    }
+    assert_eq!(lost(&net, at), (1, 5, 0));
+    assert!(net.now() - start >= 6 * 60_000 * MS - 600 * MS);
+}
+
+#[test]
+fn intelligent_synchronization_locks_on_the_loudest_initiator() {
+    let mut net = mac_net(2, SfskLine::default(), &[]);
+    configure(&mut net, 1, mode::SERVER, MAC);
+    write(&mut net, 1, 0x0001, &[0x05, 0x00, 0x00, 0x00]);
+    write(&mut net, 1, 0x0009, &[1, 0]);
+    let at = mark(&net, 1);
+    for _ in 0..3 {
+        assert_eq!(confirm(&mut net, 0, mac(0, 5, b"is")), 0xFF);
+        net.run_for(10_000 * MS);
+    }
+    assert_eq!(confirm(&mut net, 1, mac(0, CLIENT, b"no")), 0x05, "LM_IS");
+    let s = syncs(&net, 1, at);
+    // SYNC = 5, LM_IS_INIT, from C00h at 79 dBµV (under 0016h's 106).
+    assert_eq!(s.len(), 3, "{s:?}");
+    assert!(s.iter().all(|s| *s
+        == MacSync::Intelligent {
+            cause: 0x06,
+            add: CLIENT,
+            s: 7_900
+        }));
+    net.run_for(35_000 * MS);
+    let is: Vec<_> = since(&net, 1, at, Layer::Mac)
+        .into_iter()
+        .filter(|c| matches!(c, Command::IsIndication { .. }))
+        .collect();
+    assert_eq!(
+        is,
+        [Command::IsIndication {
+            is_status: 0x01,
+            locked: Some(plm_core::st7570::IsLocked { add: CLIENT, s: 7_900 })
+        }]
+    );
+    assert_eq!(read(&mut net, 1, 0x0001), [0x05, 0x00, 0x00, 0x0C], "locked");
+    find(&mut net);
+    // Fast synchronization: a louder initiator than 0016h.
+    write(&mut net, 1, 0x0016, &[0x58, 0x1B, 0, 0]);
+    write(&mut net, 1, 0x0009, &[1, 0]);
+    answer(&mut net, 1, Command::DesynchroRequest { reset: 1 });
+    let at = mark(&net, 1);
+    assert_eq!(confirm(&mut net, 0, mac(0, 5, b"fast")), 0xFF);
+    net.run_for(600 * MS);
+    let s = syncs(&net, 1, at);
+    assert!(
+        matches!(
+            s[..],
+            [
+                MacSync::Intelligent { cause: 0x07, .. },
+                MacSync::Confirmed { sa: CLIENT, .. }
+            ]
+        ),
+        "{s:?}"
+    );
+}
+
+#[test]
+fn a_repeater_call_hears_the_client_in_sub_slot_0() {
+    let mut net = mac_net(2, SfskLine::default(), &[]);
+    configure(&mut net, 1, mode::SERVER, MAC);
+    write(&mut net, 1, 0x0001, &[0x01, 0x00, 0x00, 0x00]);
+    write(&mut net, 1, 0x000B, &[0x03]);
+    let call = |net: &mut Network, threshold: u16| {
+        let at = mark(net, 1);
+        // A frame of 3 subframes; both calls while it is on the line.
+        net.submit(0, &mac(0, 1, &[0x42; 90]));
+        net.run_until(2_000 * MS, |n, e| {
+            n == 1 && matches!(e, Event::Frame(f) if f.code == 0x10)
+        });
+        let rc = Command::RcRequest {
+            tx_pos: 0,
+            rc_threshold: threshold,
+        };
+        net.submit(0, &rc);
+        net.submit(1, &rc);
+        net.run_for(2_000 * MS);
+        let client = since(net, 0, 0, Layer::Mac)
+            .into_iter()
+            .filter(|c| matches!(c, Command::RcConfirm { .. }))
+            .last();
+        let server = since(net, 1, at, Layer::Mac)
+            .into_iter()
+            .find(|c| matches!(c, Command::RcConfirm { .. }));
+        (client, server)
+    };
+    let (client, server) = call(&mut net, 7_000);
+    assert!(
+        matches!(
+            client,
+            Some(Command::RcConfirm {
+                result: 0xFF,
+                heard: None,
+                ..
+            })
+        ),
+        "{client:?}"
+    );
+    // Heard in sub-slot 0 at 79 dBµV ((S0 + S1) / 2), 60 of noise.
+    let Some(Command::RcConfirm {
+        result: 0xFF,
+        repeater_state: 3,
+        heard: Some(h),
+    }) = server
+    else {
+        panic!("{server:?}")
+    };
+    assert_eq!((h.rx_pos, h.n), (0, 6_000));
+    assert!((7_800..7_900).contains(&h.s), "{h:?}");
+    // Above the threshold: nothing valid heard.
+    net.run_for(3_000 * MS);
+    answer(&mut net, 1, Command::DesynchroRequest { reset: 1 });
+    let (_, server) = call(&mut net, 9_000);
+    assert!(
+        matches!(
+            server,
+            Some(Command::RcConfirm {
+                result: 0xFF,
+                heard: Some(plm_core::st7570::RcHeard { s: 0, n: 0, rx_pos: 0 }),
+                ..
+            })
+        ),
+        "{server:?}"
+    );
+}
+
+#[test]
+fn a_repeater_repeats_an_alarm_burst() {
+    // Node 2 hears node 0's alarms only through repeater 1.
+    let line = SfskLine {
+        attenuation_per_hop_db: 40.0,
+        ..SfskLine::default()
+    };
+    let mut net = mac_net(3, line, &[]);
+    for (n, a) in [(1u8, 1u8), (2, 2)] {
+        configure(&mut net, n as usize, mode::SERVER, MAC);
+        write(&mut net, n as usize, 0x0001, &[a, 0, 0, 0]);
+    }
+    write(&mut net, 1, 0x000B, &[0x01]);
+    // Both synchronize: a frame to 2, relayed by 1.
+    assert_eq!(confirm(&mut net, 0, mac(1, 2, b"sync")), 0xFF);
+    net.run_for(1_000 * MS);
+    let at = mark(&net, 2);
+    assert_eq!(confirm(&mut net, 0, Command::AlarmRequest), 0xFF);
+    net.run_for(6_000 * MS);
+    let got = since(&net, 2, at, Layer::Mac);
+    assert_eq!(
+        got.iter()
+            .filter(|c| matches!(c, Command::AlarmIndication { .. }))
+            .count(),
+        1,
+        "{got:?}"
+    );
+    let tx = read(&mut net, 1, 0x0084);
+    assert_eq!(u32::from_le_bytes(tx.try_into().unwrap()), 8, "N_TX repeated");
+}
