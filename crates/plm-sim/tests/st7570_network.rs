@@ -299,7 +299,7 @@ fn client_and_servers_exchange_frames_of_1_to_7_subframes() {
         assert_eq!(got.len(), 1, "NS {ns}: {got:?}");
         assert_eq!(got[0].address, Address { sa: 2, da: CLIENT });
         assert_eq!(got[0].m_sdu, payload);
-        assert_eq!(got[0].credit.ic, 1);
+        assert_eq!(got[0].credit.ic, 0, "answered with the request's IC");
     }
     let r1 = net.nodes[1].responder.as_ref().unwrap();
     let r2 = net.nodes[2].responder.as_ref().unwrap();
@@ -577,10 +577,17 @@ fn intelligent_synchronization_locks_on_the_loudest_initiator() {
         is,
         [Command::IsIndication {
             is_status: 0x01,
-            locked: Some(plm_core::st7570::IsLocked { add: CLIENT, s: 7_900 })
+            locked: Some(plm_core::st7570::IsLocked {
+                add: CLIENT,
+                s: 7_900
+            })
         }]
     );
-    assert_eq!(read(&mut net, 1, 0x0001), [0x05, 0x00, 0x00, 0x0C], "locked");
+    assert_eq!(
+        read(&mut net, 1, 0x0001),
+        [0x05, 0x00, 0x00, 0x0C],
+        "locked"
+    );
     find(&mut net);
     // Fast synchronization: a louder initiator than 0016h.
     write(&mut net, 1, 0x0016, &[0x58, 0x1B, 0, 0]);
@@ -624,8 +631,7 @@ fn a_repeater_call_hears_the_client_in_sub_slot_0() {
         net.run_for(2_000 * MS);
         let client = since(net, 0, 0, Layer::Mac)
             .into_iter()
-            .filter(|c| matches!(c, Command::RcConfirm { .. }))
-            .last();
+            .rfind(|c| matches!(c, Command::RcConfirm { .. }));
         let server = since(net, 1, at, Layer::Mac)
             .into_iter()
             .find(|c| matches!(c, Command::RcConfirm { .. }));
@@ -663,7 +669,11 @@ fn a_repeater_call_hears_the_client_in_sub_slot_0() {
             server,
             Some(Command::RcConfirm {
                 result: 0xFF,
-                heard: Some(plm_core::st7570::RcHeard { s: 0, n: 0, rx_pos: 0 }),
+                heard: Some(plm_core::st7570::RcHeard {
+                    s: 0,
+                    n: 0,
+                    rx_pos: 0
+                }),
                 ..
             })
         ),
@@ -699,5 +709,9 @@ fn a_repeater_repeats_an_alarm_burst() {
         "{got:?}"
     );
     let tx = read(&mut net, 1, 0x0084);
-    assert_eq!(u32::from_le_bytes(tx.try_into().unwrap()), 8, "N_TX repeated");
+    assert_eq!(
+        u32::from_le_bytes(tx.try_into().unwrap()),
+        8,
+        "N_TX repeated"
+    );
 }

@@ -47,6 +47,14 @@ pub(super) struct Burst {
 }
 
 impl St7570 {
+    /// When the last burst heard ends: the start of the slot after its
+    /// last copy.
+    pub(super) fn burst_end(&self) -> Instant {
+        self.burst
+            .as_ref()
+            .map_or(0, |b| b.until * self.slots().slot)
+    }
+
     /// A subframe heard in MAC mode (Client, Server or Monitor).
     pub(super) fn hear_mac(&mut self, now: Instant, heard: &Heard) -> bool {
         let slot = self.slots().slot_number(now);

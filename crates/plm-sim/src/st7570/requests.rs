@@ -178,7 +178,9 @@ impl St7570 {
             return refuse(code);
         }
         let clock = self.slots();
-        let start = clock.next_slot(now);
+        // A burst heard is not over until its last copy (4.8): the slots
+        // until then are its repetitions', so the frame waits (model).
+        let start = clock.next_slot(now).max(self.burst_end());
         let (slots, frame_slots, count) = match cmd {
             Command::PhyDataRequest { p_sdu } => {
                 let mut p = [0u8; plm_core::st7570::fields::P_SDU_LEN];

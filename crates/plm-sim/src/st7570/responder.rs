@@ -6,7 +6,7 @@
 //! What it answers is ours (the manual has no application layer): an
 //! M_SDU starting with `?` draws `!` and the node's address and the
 //! delta-phase it measured (000Eh), anything else is echoed. Answers go to
-//! the sender with IC 1.
+//! the sender with the IC the request came with (the way back is as long).
 
 use super::drive::ModemDriver;
 use super::mode;
@@ -14,9 +14,6 @@ use plm_core::link::host::Event;
 use plm_core::st7570::mib::{index, object, PlcConfiguration};
 use plm_core::st7570::{code, Address, Command, Credit, Layer, MacData};
 use std::collections::VecDeque;
-
-/// Initial credit of the answers.
-pub const ANSWER_IC: u8 = 1;
 
 /// A Server's host.
 #[derive(Debug, Clone)]
@@ -105,8 +102,8 @@ impl Responder {
         };
         Command::MacDataRequest(MacData {
             credit: Credit {
-                ic: ANSWER_IC,
-                cc: ANSWER_IC,
+                ic: m.credit.ic,
+                cc: m.credit.ic,
                 dc: m.credit.ic.saturating_sub(m.credit.cc).min(3),
             },
             address: Address {
