@@ -79,6 +79,20 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
+            name: "ST7570: 50-node S-FSK network with repeaters, simulated s per wall s (native)",
+            sources: &["crates/plm-sim/examples/bench_st7570.rs"],
+            cmd: Cmd::new("cargo").args([
+                "run",
+                "--profile",
+                "bench-native",
+                "-p",
+                "plm-sim",
+                "--example",
+                "bench_st7570",
+            ]),
+            needs_dist: false,
+        },
+        Bench {
             name:
                 "console in Chromium: ACK latency, MIB-read rate, Street view with 500 lamps, size",
             sources: &["tests/e2e/bench.mjs"],

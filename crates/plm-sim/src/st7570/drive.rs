@@ -1,7 +1,7 @@
 //! plm-core's host engine driving one simulated ST7570 over a byte-level
 //! UART in virtual time (ST7570 UM 5.1-5.2), as [`crate::drive`] does for
-//! the ST7580 world: tests and benches use it until the S-FSK network
-//! puts the model into [`crate::Sim`].
+//! the ST7580 world: one node of the S-FSK network ([`super::net`]), or a
+//! modem alone in tests.
 
 use super::St7570;
 use crate::rng::Rng;
@@ -48,6 +48,12 @@ impl ModemDriver {
     /// A modem powered on at 0 and a host with the reset timeouts, both at
     /// `baud`.
     pub fn new(baud: u32) -> Self {
+        Self::with_seed(baud, 0x7570)
+    }
+
+    /// As [`ModemDriver::new`], the UART faults (none by default) drawing
+    /// on an RNG seeded with `seed`.
+    pub fn with_seed(baud: u32, seed: u64) -> Self {
         ModemDriver {
             modem: St7570::new(baud, 0),
             host: HostEngine::new(Dialect::St7570, HostConfig::at_reset(Dialect::St7570, baud)),
@@ -55,7 +61,7 @@ impl ModemDriver {
             now: 0,
             to_modem: Wire::new(baud),
             to_host: Wire::new(baud),
-            rng: Rng::new(0x7570),
+            rng: Rng::new(seed),
             at_modem: VecDeque::new(),
             at_host: VecDeque::new(),
             treq: VecDeque::new(),
@@ -85,16 +91,7 @@ impl ModemDriver {
                     return true;
                 }
             }
-            let next = [
-                self.host.poll_timeout(),
-                self.modem.poll_timeout(),
-                self.at_modem.front().map(|b| b.0),
-                self.at_host.front().map(|b| b.0),
-                self.treq.front().map(|t| t.0),
-            ]
-            .into_iter()
-            .fold(None, earliest);
-            match next {
+            match self.next_due() {
                 Some(t) if t <= end => self.now = self.now.max(t),
                 _ => {
                     self.now = end;
@@ -103,6 +100,34 @@ impl ModemDriver {
             }
             self.step();
         }
+    }
+
+    /// The next moment something is due on either side or on a wire.
+    pub fn next_due(&self) -> Option<Instant> {
+        [
+            self.host.poll_timeout(),
+            self.modem.poll_timeout(),
+            self.at_modem.front().map(|b| b.0),
+            self.at_host.front().map(|b| b.0),
+            self.treq.front().map(|t| t.0),
+        ]
+        .into_iter()
+        .fold(None, earliest)
+    }
+
+    /// Moves virtual time to `t` (never back), runs what is due and hands
+    /// the outputs on: a network steps its nodes with this.
+    pub fn advance(&mut self, t: Instant) {
+        self.now = self.now.max(t);
+        self.step();
+        self.move_bytes();
+    }
+
+    /// Hands on what either side has to say after something outside (the
+    /// line, a host program) acted at `now` (never back).
+    pub fn flush(&mut self, now: Instant) {
+        self.now = self.now.max(now);
+        self.move_bytes();
     }
 
     /// Runs for `d` µs.

@@ -20,16 +20,21 @@
 //! - [`drive`]: plm-core's host engine driving one model in virtual time.
 
 pub mod drive;
+pub mod line;
+mod mac_rx;
+pub mod net;
 mod receive;
 mod requests;
+pub mod responder;
 pub mod slots;
 pub mod store;
+mod sync;
 
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::Transmit;
 use plm_core::link::{Dialect, Element};
 use plm_core::st7570::mib::index;
-use plm_core::st7570::{Command, Layer, Status};
+use plm_core::st7570::{Command, IsLocked, Layer, SignalNoise, Status};
 use plm_core::time::{earliest, Duration, Instant, MS};
 pub use slots::{Heard, SlotClock, SlotUse, TestTone, Transmission};
 use std::collections::VecDeque;
@@ -107,6 +112,24 @@ pub struct St7570 {
     spy_from: Instant,
     jobs: Vec<TxJob>,
     line_out: VecDeque<Transmission>,
+    /// The line's noise here: what a PHY Monitor measures in a slot with
+    /// nothing in it (A0h, E0h).
+    line_noise: SignalNoise,
+    /// MAC timeouts (0002h-0004h, 0009h) run this many times faster.
+    timeout_scale: u64,
+    /// MAC: the subframes of a long frame being received (4.4).
+    assembly: Option<mac_rx::Assembly>,
+    /// MAC: the last burst taken, to tell its repetitions (4.8).
+    burst: Option<mac_rx::Burst>,
+    /// MAC Server: the synchronization state (4.6, 4.7).
+    mac_state: sync::MacState,
+    /// Intelligent synchronization: the initiator heard loudest.
+    is_best: Option<IsLocked>,
+    /// PHY Monitor: the slots the last subframe and alarm were heard in.
+    spy_subframe_slot: Option<u64>,
+    spy_alarm: Option<(u64, SignalNoise)>,
+    /// Repeater call: the threshold of the call requested (7.3).
+    rc_threshold: u32,
 }
 
 impl St7570 {
@@ -129,6 +152,15 @@ impl St7570 {
             spy_from: 0,
             jobs: Vec::new(),
             line_out: VecDeque::new(),
+            line_noise: SignalNoise::default(),
+            timeout_scale: 1,
+            assembly: None,
+            burst: None,
+            mac_state: sync::MacState::Off,
+            is_best: None,
+            spy_subframe_slot: None,
+            spy_alarm: None,
+            rc_threshold: 0,
         };
         m.restart(now, false, true);
         m
@@ -233,8 +265,26 @@ impl St7570 {
         self.spy_from = now;
         if fail {
             self.heard_sync = false;
+            self.forget_mac();
         }
         self.refresh_status();
+    }
+
+    /// Whether the mains zero crossing is lost (status ZC_FAIL).
+    pub fn zc_fail(&self) -> bool {
+        self.zc_fail
+    }
+
+    /// The line's noise at this modem (the line sets it).
+    pub fn set_line_noise(&mut self, sn: SignalNoise) {
+        self.line_noise = sn;
+    }
+
+    /// Makes the MAC timeouts (0002h-0004h, 0009h) run `scale` times
+    /// faster, so that a demo shows a 360-minute timeout in 6 minutes at
+    /// 60 (a simulation knob; the chip has none).
+    pub fn set_timeout_scale(&mut self, scale: u64) {
+        self.timeout_scale = scale.max(1);
     }
 
     /// A hardware reset (power cycle or RESETn) at `now`: the stored
@@ -255,6 +305,7 @@ impl St7570 {
         self.alarm_flag = false;
         self.jobs.clear();
         self.line_out.clear();
+        self.forget_mac();
         self.power = if power_on {
             Power::On
         } else {
@@ -320,6 +371,7 @@ impl St7570 {
                 });
                 let mut t = earliest(self.engine.poll_timeout(), self.is_until);
                 t = earliest(t, self.spy_due());
+                t = earliest(t, self.mac_due());
                 for j in jobs {
                     t = earliest(t, Some(j));
                 }
@@ -338,17 +390,9 @@ impl St7570 {
         }
         self.run_jobs(now);
         self.spy_tick(now);
+        self.mac_tick(now);
         if self.is_until.is_some_and(|t| now >= t) {
-            self.is_until = None;
-            // 5.3.25: no valid frame from an initiator within the timeout
-            // (nobody on the line can have sent one): LM_NOT_LOCKED.
-            self.submit(
-                now,
-                Command::IsIndication {
-                    is_status: 0x02,
-                    locked: None,
-                },
-            );
+            self.is_end(now);
         }
         self.refresh_status();
         self.engine.handle_timeout(now);
@@ -404,7 +448,7 @@ impl St7570 {
             && ctx.layer == Layer::Mac
             && ctx.mode == mode::SERVER
             && !self.synchronized())
-        .then(|| now + minutes * 60_000 * MS);
+        .then(|| now + minutes * 60_000 * MS / self.timeout_scale);
     }
 
     fn submit(&mut self, now: Instant, cmd: Command) {
@@ -439,6 +483,7 @@ impl St7570 {
     /// mode change).
     fn lose_sync(&mut self, now: Instant) {
         self.heard_sync = false;
+        self.forget_mac();
         self.spy_from = now;
         self.client_found = false;
         self.start_is(now);

@@ -32,8 +32,6 @@ pub mod confirm {
 
 /// 5.3.26: ERROR is 01h.
 const SYNTAX_ERROR: Command = Command::SyntaxError { error: 0x01 };
-/// 5.3.1, Table 18: CAUSE 5, the host rejected the synchronization.
-const LOST_BY_HOST: u8 = 5;
 
 impl St7570 {
     /// The answer to a request the link engine accepted, if any.
@@ -91,7 +89,10 @@ impl St7570 {
                 return self.data_request(now, cmd)
             }
             Command::AlarmRequest => return self.alarm_request(now),
-            Command::RcRequest { tx_pos, .. } => return self.rc_request(tx_pos),
+            Command::RcRequest {
+                tx_pos,
+                rc_threshold,
+            } => return self.rc_request(tx_pos, rc_threshold),
             // Every other code is refused above (not a request).
             _ => SYNTAX_ERROR,
         })
@@ -133,7 +134,7 @@ impl St7570 {
         self.lose_sync(now);
         (self.layer() == Layer::Mac).then(|| {
             Command::MacSynchroIndication(MacSync::Lost {
-                cause: LOST_BY_HOST,
+                cause: super::sync::cause::HOST,
                 add1: self.mib.local_address(),
                 add2: self.mib.word(index::LOCAL_INIT_MAC_ADD, 2),
             })
@@ -177,7 +178,9 @@ impl St7570 {
             return refuse(code);
         }
         let clock = self.slots();
-        let start = clock.next_slot(now);
+        // A burst heard is not over until its last copy (4.8): the slots
+        // until then are its repetitions', so the frame waits (model).
+        let start = clock.next_slot(now).max(self.burst_end());
         let (slots, frame_slots, count) = match cmd {
             Command::PhyDataRequest { p_sdu } => {
                 let mut p = [0u8; plm_core::st7570::fields::P_SDU_LEN];
@@ -245,7 +248,7 @@ impl St7570 {
         Some((slots, ns, copies as u32))
     }
 
-    fn queue_line(&mut self, start: Instant, slots: Vec<SlotUse>) {
+    pub(super) fn queue_line(&mut self, start: Instant, slots: Vec<SlotUse>) {
         let plc = self.mib.plc();
         self.line_out.push_back(Transmission {
             start,
@@ -299,7 +302,7 @@ impl St7570 {
     /// Client calls at sub-slot 0, a Server at TX_POS or its local
     /// address, and the confirm comes at the end of that slot. With nobody
     /// on the line a Server hears no pattern (S, N, RX_POS all 0).
-    fn rc_request(&mut self, tx_pos: u16) -> Option<Command> {
+    fn rc_request(&mut self, tx_pos: u16, rc_threshold: u16) -> Option<Command> {
         let repeater = self.mib.tic_repeater();
         let server = self.mode() != mode::CLIENT;
         let refuse = |result| {
@@ -318,15 +321,22 @@ impl St7570 {
         if server && repeater.repeater_settings == 0 {
             return refuse(confirm::NOT_VALID);
         }
-        let Some(after) = self.jobs.iter().map(|j| j.end).max() else {
+        // A transmission of this modem, or a frame being received.
+        let clock = self.slots();
+        let receiving = self.assembly.as_ref().map(|a| a.end_slot() * clock.slot);
+        let Some(after) = self.jobs.iter().map(|j| j.end).max().or(receiving) else {
             return refuse(confirm::BUSY);
+        };
+        // 5.3.23: RC_THRESHOLD 0 takes 000Ch.
+        self.rc_threshold = match rc_threshold {
+            0 => self.mib.word(0x000C, 0) as u32,
+            t => t as u32,
         };
         let position = match (server, tx_pos) {
             (false, _) => 0,
             (true, 0) => self.mib.local_address(),
             (true, p) => p,
         };
-        let clock = self.slots();
         self.queue_line(after, vec![SlotUse::RepeaterCall { position }]);
         let end = after + clock.slot;
         self.jobs.push(TxJob {

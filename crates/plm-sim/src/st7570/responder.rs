@@ -1,0 +1,117 @@
+//! A simulated Server node's host: it configures its ST7570 as a MAC
+//! Server (optionally a repeater) with a local address, then answers what
+//! is sent to that address, so that a demo shows traffic. It drives the
+//! modem through plm-core's host engine, as the console does.
+//!
+//! What it answers is ours (the manual has no application layer): an
+//! M_SDU starting with `?` draws `!` and the node's address and the
+//! delta-phase it measured (000Eh), anything else is echoed. Answers go to
+//! the sender with the IC the request came with (the way back is as long).
+
+use super::drive::ModemDriver;
+use super::mode;
+use plm_core::link::host::Event;
+use plm_core::st7570::mib::{index, object, PlcConfiguration};
+use plm_core::st7570::{code, Address, Command, Credit, Layer, MacData};
+use std::collections::VecDeque;
+
+/// A Server's host.
+#[derive(Debug, Clone)]
+pub struct Responder {
+    /// The local MAC address it gives its modem.
+    pub address: u16,
+    /// Requests to send, in order, one at a time.
+    queue: VecDeque<Command>,
+    /// The request waiting for its answer.
+    waiting: Option<u8>,
+    /// Frames indicated to it, and answers confirmed LM_OK.
+    pub indicated: u64,
+    /// Answers the modem confirmed LM_OK.
+    pub answered: u64,
+}
+
+impl Responder {
+    /// A host that makes its modem a MAC Server at `address` (a repeater,
+    /// ALWAYS_REPEAT, if `repeater`).
+    pub fn new(address: u16, repeater: bool) -> Self {
+        let mut plc = PlcConfiguration::decode(object(index::PLC_CONFIGURATION).unwrap().default);
+        plc.operating_mode = mode::SERVER;
+        plc.access_layer_mode = Layer::Mac.access_layer_mode();
+        let mut queue = VecDeque::new();
+        let write = |index: u16, data: Vec<u8>| Command::WriteDbRequest { index, data };
+        queue.push_back(write(index::PLC_CONFIGURATION, plc.encode()));
+        let mut local = address.to_le_bytes().to_vec();
+        local.extend_from_slice(&[0, 0]);
+        queue.push_back(write(index::LOCAL_INIT_MAC_ADD, local));
+        if repeater {
+            queue.push_back(write(index::TIC_REPEATER, vec![0x01]));
+        }
+        Responder {
+            address,
+            queue,
+            waiting: None,
+            indicated: 0,
+            answered: 0,
+        }
+    }
+
+    /// Acts on the host events since the last call and sends the next
+    /// request if none is waiting.
+    pub fn step(&mut self, d: &mut ModemDriver) {
+        if d.events.is_empty() && (self.waiting.is_some() || self.queue.is_empty()) {
+            return;
+        }
+        let layer = d.modem.layer();
+        for (_, e) in std::mem::take(&mut d.events) {
+            match e {
+                Event::Frame(f) => {
+                    if self
+                        .waiting
+                        .is_some_and(|r| code::answers(r, f.code, layer))
+                    {
+                        self.waiting = None;
+                    }
+                    match Command::from_frame(&f, layer) {
+                        Ok(Command::MacDataIndication(m)) if m.address.da == self.address => {
+                            self.indicated += 1;
+                            let answer = self.answer(d, &m);
+                            self.queue.push_back(answer);
+                        }
+                        Ok(Command::DataConfirm { confirm_code: 0xFF }) => self.answered += 1,
+                        _ => {}
+                    }
+                }
+                Event::Failed(..) => self.waiting = None,
+                _ => {}
+            }
+        }
+        if self.waiting.is_none() {
+            if let Some(cmd) = self.queue.pop_front() {
+                self.waiting = Some(cmd.code());
+                d.submit(&cmd);
+            }
+        }
+    }
+
+    fn answer(&self, d: &ModemDriver, m: &MacData) -> Command {
+        let m_sdu = if m.m_sdu.first() == Some(&b'?') {
+            let phase = d.modem.mib().byte(0x000E, 8);
+            format!("!{:03X} phase {phase}", self.address).into_bytes()
+        } else {
+            m.m_sdu.clone()
+        };
+        Command::MacDataRequest(MacData {
+            credit: Credit {
+                ic: m.credit.ic,
+                cc: m.credit.ic,
+                dc: m.credit.ic.saturating_sub(m.credit.cc).min(3),
+            },
+            address: Address {
+                sa: self.address,
+                da: m.address.sa,
+            },
+            pad: 0,
+            m_sdu,
+        })
+    }
+}
