@@ -44,9 +44,11 @@ fn check_params(p: &TxParams) -> Result<(), Refusal> {
             .map_err(|e| wpv(format!("{e}")))?;
     }
     if let Some(g) = p.tx_gain {
+        // Table 35: the gain is bits 0-4 of its byte; bits 5-7, "Unused",
+        // must be 0 like every unused or reserved bit (protocol notes).
         tx_options::TX_GAIN
             .check(g as i64)
-            .map_err(|e| wpv(format!("{e}")))?;
+            .map_err(|e| wpv(format!("{e} (bits 5-7 of the TX gain byte are unused: 0)")))?;
     }
     Ok(())
 }
@@ -202,6 +204,32 @@ mod tests {
                 .cause,
             ErrorCause::WrongParameterLength
         );
+    }
+
+    #[test]
+    fn unused_gain_bits_are_refused_like_a_mib_objects() {
+        // One policy for unused and reserved bits (protocol notes): Table
+        // 35's TX gain byte, bits 5-7, as Table 54's byte 7 bits 5-7.
+        let mut r = DataRequest::default();
+        r.params.tx_gain = Some(0x20 | 21);
+        let phy = Command::PhyDataRequest(r.clone());
+        let parsed = Command::parse(phy.code(), &phy.data()).unwrap();
+        assert_eq!(parsed, phy, "the unused bits are kept");
+        let e = check_request(&parsed, 4).unwrap_err();
+        assert_eq!(e.cause, ErrorCause::WrongParameterValue);
+        assert!(e.reason.contains("unused"), "{e}");
+        let mut phy_config = mib::OBJECTS[1].default.to_vec();
+        phy_config[7] |= 0x20;
+        let mib = Command::MibWriteRequest {
+            index: 1,
+            data: phy_config,
+        };
+        assert_eq!(
+            check_request(&mib, 4).unwrap_err().cause,
+            ErrorCause::WrongParameterValue
+        );
+        r.params.tx_gain = Some(21);
+        assert!(check_request(&Command::PhyDataRequest(r), 4).is_ok());
     }
 
     #[test]
