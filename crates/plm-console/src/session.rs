@@ -561,9 +561,8 @@ impl Session {
         }
     }
 
-    fn traffic(&mut self, at: Instant, element: &Element, from: &str) {
-        let mut decoded = self.decoder.decode(element);
-        decoded.from = Some(from.to_string());
+    fn traffic(&mut self, at: Instant, element: &Element, from: Source) {
+        let decoded = self.decoder.decode_from(from, element);
         self.out.notes.push(Note::Traffic {
             at: self.log_time(at),
             decoded: Box::new(decoded),
@@ -579,7 +578,7 @@ impl Session {
                         self.out.notes.push(Note::Status { at, byte });
                     }
                 }
-                self.traffic(now, &el, "modem");
+                self.traffic(now, &el, Source::Modem);
             }
             Event::Sent(el) => {
                 if matches!(el, Element::Ack) {
@@ -592,7 +591,7 @@ impl Session {
                         self.page_now.max(written).saturating_sub(now),
                     );
                 }
-                self.traffic(now, &el, "host")
+                self.traffic(now, &el, Source::Host)
             }
             Event::Frame(f) => self.on_frame(now, f),
             Event::Repeat(_) => {}
