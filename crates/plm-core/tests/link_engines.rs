@@ -450,11 +450,18 @@ fn gap_in_host_frame_is_dropped_by_device_and_host_retries() {
             }
         )
     );
-    // No answer at all to the broken frame: the only things the device
-    // sent are the two statuses, one ACK (the restarted frame) and the
-    // confirm.
-    let sent: Vec<&str> = sim.dev_sent().iter().map(|(_, e)| e.kind()).collect();
-    assert_eq!(sent, ["status", "status", "ack", "frame"]);
+    // UM0932 3.2.8, "in other cases, it answers with a NAK": the frame
+    // cut short is NAKed as T_IC ends it, and the host restarts at once
+    // instead of waiting out T_ACK. Then the second status, the ACK of
+    // the restarted frame and the confirm.
+    let sent = sim.dev_sent();
+    let kinds: Vec<&str> = sent.iter().map(|(_, e)| e.kind()).collect();
+    assert_eq!(kinds, ["status", "nak", "status", "ack", "frame"]);
+    assert_eq!(sent[1].0, f0[3].at + T_IC);
+    assert_eq!(
+        sim.dev_events_where(|e| *e == DeviceEvent::FrameCut).len(),
+        1
+    );
     let e = sim.host_events_where(|e| is_retry(e) || is_failed(e) || is_delivered(e));
     assert_eq!(
         e.iter().map(|(_, e)| e.clone()).collect::<Vec<_>>(),
@@ -462,7 +469,7 @@ fn gap_in_host_frame_is_dropped_by_device_and_host_retries() {
             Event::Retry {
                 ticket,
                 attempt: 1,
-                cause: LinkError::NoAck
+                cause: LinkError::Nak
             },
             Event::Delivered(ticket)
         ]
@@ -497,15 +504,20 @@ fn gap_in_modem_frame_is_dropped_by_host_and_repeat_accepted() {
             })
         )
     );
-    // The host answers nothing to the broken frame; its only byte is the
-    // ACK of the repeat.
+    // The host NAKs the frame cut short as T_IC ends it (3.2.7: "In other
+    // cases, it answers with a NAK"), then ACKs the repeat.
     let repeat = sim.frame_bytes(Dir::DevToHost, 1);
     assert_eq!(repeat[0].sent, 0x03);
-    let h2d: Vec<_> = sim.wire(Dir::HostToDev).copied().collect();
-    assert_eq!(h2d.len(), 1);
+    let h2d: Vec<_> = sim
+        .wire(Dir::HostToDev)
+        .map(|w| (w.part, w.start))
+        .collect();
     assert_eq!(
-        (h2d[0].part, h2d[0].start),
-        (Part::Ack, repeat.last().unwrap().at)
+        h2d,
+        vec![
+            (Part::Nak, f0[3].at + T_IC),
+            (Part::Ack, repeat.last().unwrap().at)
+        ]
     );
     // The device repeated T_ACK after the frame as far as it knew (it does
     // not see its own UART stall).
@@ -1268,7 +1280,7 @@ fn host_retries_a_not_now_status_with_a_new_edge_and_takes_the_modem_frame_first
     let b1 = b(BAUD);
     let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
     // Bits 1-2 of the status: transmission or reception in progress.
-    sim.host.set_not_now(0b0000_0110);
+    sim.host.set_not_now(0b0000_0110, 0);
     sim.dev
         .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x02]));
     let req = ping();

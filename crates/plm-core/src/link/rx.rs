@@ -1,6 +1,15 @@
 //! Byte-by-byte receiver shared by both link engines: assembles frames,
 //! ACK/NAK and status messages, and applies T_IC (UM0932 3.2.6): after a
 //! pause longer than T_IC inside an element, the bytes so far are dropped.
+//!
+//! A frame that cannot be right (its checksum is wrong, or T_IC ended it
+//! short) is also searched for a later STX, as [`super::StreamDecoder`]
+//! does for captures: when a frame that can still be right starts there,
+//! the bytes before it are garbage and reception goes on from that STX.
+//! A USB-UART adapter that holds bytes back (FTDI's latency timer: 16 ms)
+//! delivers the stalled tail of a frame and the modem's repeat in one
+//! burst; without this, an 02h or 03h in the tail swallows the repeat.
+//! See docs/protocol-notes.md, "Known limits of the host interface".
 
 use super::{
     Dialect, Element, Frame, FrameError, GarbageReason, Source, StatusMessage, ACK, NAK,
@@ -8,6 +17,15 @@ use super::{
 };
 use crate::time::{Duration, Instant};
 use alloc::vec::Vec;
+
+/// Whether `e` is a frame cut short: its STX and length came, T_IC ended
+/// it before the length was complete (UM0932 3.2.6). The receiving side
+/// answers it with NAK (3.2.7, 3.2.8: "In other cases, it answers with a
+/// NAK"), except where [`Dialect::modem_naks_cut_frame`] says otherwise.
+pub(crate) fn is_cut_frame(dialect: Dialect, e: &Element) -> bool {
+    matches!(e, Element::Garbage { bytes, reason: GarbageReason::Truncated }
+        if bytes.first().is_some_and(|&b| dialect.is_stx(b)))
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Partial {
@@ -23,6 +41,9 @@ pub(crate) struct Receiver {
     peer: Source,
     buf: Vec<u8>,
     partial: Partial,
+    /// Bytes at the start of `buf` already reported in a frame with a
+    /// wrong checksum: the frame being received started inside it.
+    reported: usize,
     last_byte_at: Instant,
     /// When the first byte of the element being received, or of the last
     /// one completed, arrived.
@@ -36,6 +57,7 @@ impl Receiver {
             peer,
             buf: Vec::new(),
             partial: Partial::None,
+            reported: 0,
             last_byte_at: 0,
             started_at: 0,
         }
@@ -66,17 +88,56 @@ impl Receiver {
     }
 
     fn flush(&mut self, out: &mut Vec<Element>) {
-        let reason = match self.partial {
-            Partial::Garbage => GarbageReason::Unexpected,
-            _ => GarbageReason::Truncated,
-        };
-        if !self.buf.is_empty() {
-            out.push(Element::Garbage {
-                bytes: core::mem::take(&mut self.buf),
-                reason,
-            });
+        // Cut short by T_IC: a whole right frame may start inside.
+        if self.partial == Partial::Frame && self.reported == 0 {
+            if let Some(q) = self.resync_at(true) {
+                self.restart_at(q, out);
+                return self.flush(out);
+            }
         }
+        // A frame started inside a bad one proved nothing: no NAK for it.
+        let reason = match self.partial {
+            Partial::Frame | Partial::Status if self.reported == 0 => GarbageReason::Truncated,
+            _ => GarbageReason::Unexpected,
+        };
+        self.garbage(reason, out);
+    }
+
+    /// Reports the bytes not reported yet as garbage; nothing is partial.
+    fn garbage(&mut self, reason: GarbageReason, out: &mut Vec<Element>) {
+        let bytes = self.buf.split_off(self.reported.min(self.buf.len()));
+        if !bytes.is_empty() {
+            out.push(Element::Garbage { bytes, reason });
+        }
+        self.clear();
+    }
+
+    fn clear(&mut self) {
+        self.buf.clear();
+        self.reported = 0;
         self.partial = Partial::None;
+    }
+
+    /// Where, after its STX, a frame starts in the partial frame that is
+    /// whole with a right checksum (`whole`), or not whole yet.
+    fn resync_at(&self, whole: bool) -> Option<usize> {
+        (1..self.buf.len()).find(|&q| {
+            self.dialect.is_stx(self.buf[q])
+                && match Frame::new_checked(&self.buf[q..], self.dialect) {
+                    Ok(f) => whole && f.checksum_ok(),
+                    Err(e) => !whole && matches!(e, FrameError::Truncated { .. }),
+                }
+        })
+    }
+
+    /// Reports the bytes before `q` as garbage and receives the rest again
+    /// as if they had arrived with the last byte.
+    fn restart_at(&mut self, q: usize, out: &mut Vec<Element>) {
+        let rest = self.buf.split_off(q);
+        self.garbage(GarbageReason::Unexpected, out);
+        for b in rest {
+            self.push(self.last_byte_at, b, 0, out);
+        }
     }
 
     /// Takes one byte received at `now`; completed elements go to `out`.
@@ -89,14 +150,27 @@ impl Receiver {
             Partial::Frame => {
                 self.buf.push(byte);
                 match Frame::new_checked(&self.buf[..], self.dialect) {
-                    Ok(f) => {
+                    Ok(f) if f.checksum_ok() || self.reported == 0 => {
                         out.push(Element::from_frame(&f));
-                        self.buf.clear();
-                        self.partial = Partial::None;
+                        let n = self.buf.len();
+                        // A frame that cannot be right: one still coming
+                        // may have started inside it (the stall above).
+                        match (f.checksum_ok(), self.resync_at(false)) {
+                            (false, Some(q)) => {
+                                self.buf.drain(..q);
+                                self.reported = n - q;
+                                self.started_at = now;
+                            }
+                            _ => self.clear(),
+                        }
                     }
+                    // Started inside a bad frame, and wrong too: garbage.
+                    Ok(_) => self.garbage(GarbageReason::Unexpected, out),
                     Err(FrameError::Truncated { .. }) => {}
                     Err(_) => {
                         // An impossible length byte: not a frame after all.
+                        self.buf.drain(..self.reported);
+                        self.reported = 0;
                         self.partial = Partial::Garbage;
                     }
                 }

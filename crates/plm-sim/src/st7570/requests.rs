@@ -31,7 +31,7 @@ pub mod confirm {
 }
 
 /// 5.3.26: ERROR is 01h.
-const SYNTAX_ERROR: Command = Command::SyntaxError { error: 0x01 };
+pub(super) const SYNTAX_ERROR: Command = Command::SyntaxError { error: 0x01 };
 /// 5.3.1, Table 18: CAUSE 5, the host rejected the synchronization.
 const LOST_BY_HOST: u8 = 5;
 
