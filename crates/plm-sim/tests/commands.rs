@@ -2,7 +2,7 @@
 //! of UM0932 Table 10, with the confirms, errors (Table 14) and indications
 //! the manual gives.
 
-use plm_core::link::host::Event;
+use plm_core::link::host::{Event, LinkError};
 use plm_core::link::{Element, LocalFrame};
 use plm_core::st7580::mib::{index, MibObject, ModemConfig, PhyConfig};
 use plm_core::st7580::{
@@ -301,4 +301,48 @@ fn mib_09h_changes_the_timeouts() {
     let ch = plm_core::time::wire_time(1, sim.baud());
     assert_eq!(gap - ch, 10 * MS);
     assert_eq!(got.len(), 13, "one repeat only");
+}
+
+#[test]
+fn a_transmitting_modem_takes_no_frame_from_a_host_that_ignores_the_status() {
+    // A host that sends whatever the status says (issue 13, point 2).
+    let mut d = driver(1);
+    d.host.set_not_now(0, 10 * MS);
+    let long = phy(&[0x55; 200], Modulation::BPskCoded);
+    d.submit(&Command::PhyDataRequest(long));
+    d.run_for(10 * MS);
+    // Acked, the transmission runs for about 350 ms. A ping now is sent
+    // after a status with bit 1 set: the modem ignores it (UM0932 3.2.8,
+    // like a frame outside T_SR): no ACK, no NAK, every attempt.
+    let start = d.events.len();
+    let ticket = d.submit(&Command::PingRequest { data: vec![7] });
+    d.run_until(
+        2_000 * MS,
+        |e| matches!(e, Event::Delivered(t) | Event::Failed(t, _) if *t == ticket),
+    );
+    let seen: Vec<&Event> = d.events[start..].iter().map(|(_, e)| e).collect();
+    let no_acks = seen
+        .iter()
+        .filter(|e| {
+            matches!(
+                e,
+                Event::Retry {
+                    cause: LinkError::NoAck,
+                    ..
+                }
+            )
+        })
+        .count();
+    assert_eq!(no_acks, 2, "{seen:#?}");
+    assert!(seen.contains(&&Event::Failed(ticket, LinkError::NoAck)));
+    assert!(!seen
+        .iter()
+        .any(|e| matches!(e, Event::Received(Element::Nak))));
+    // Three attempts within the transmission: none executed.
+    d.run_for(500 * MS);
+    let pings = d.events[start..]
+        .iter()
+        .filter(|(_, e)| matches!(e, Event::Frame(f) if f.code == code::PING_CONFIRM))
+        .count();
+    assert_eq!(pings, 0);
 }

@@ -275,4 +275,59 @@ mod tests {
             ]
         );
     }
+
+    /// The stall of "Known limits": the tail of a frame and the modem's
+    /// repeat in one burst. `repeat` is `03 03 2D 11 22 33 ..`.
+    fn burst(tail: &[u8]) -> (Vec<Element>, LocalFrame) {
+        let repeat = LocalFrame {
+            stx: crate::link::Stx::Repeat,
+            ..LocalFrame::new(0x2D, vec![0x11, 0x22, 0x33])
+        };
+        let mut bytes = tail.to_vec();
+        bytes.extend(repeat.emit(Dialect::St7580).unwrap());
+        let mut rx = Receiver::new(Dialect::St7580, Source::Modem);
+        let mut out = Vec::new();
+        for b in bytes {
+            rx.push(0, b, 10_000, &mut out);
+        }
+        rx.timeout(10_000, 10_000, &mut out);
+        (out, repeat)
+    }
+
+    #[test]
+    fn a_frame_cut_short_gives_up_the_repeat_inside_it() {
+        // The tail's 02h announces 40h bytes: T_IC ends it, and the
+        // whole right frame inside is taken; the rest is no cut frame.
+        let (out, repeat) = burst(&[0x11, 0x02, 0x40, 0x96]);
+        assert_eq!(out.len(), 3, "{out:?}");
+        assert_eq!(
+            out[1],
+            Element::Garbage {
+                bytes: vec![0x02, 0x40, 0x96],
+                reason: GarbageReason::Unexpected
+            }
+        );
+        assert!(
+            matches!(&out[2], Element::Frame { frame, checksum_ok: true, .. } if *frame == repeat)
+        );
+    }
+
+    #[test]
+    fn a_frame_with_a_wrong_checksum_gives_up_the_repeat_starting_inside_it() {
+        // The tail's 02h announces 1 byte: that frame ends two bytes into
+        // the repeat, checksum wrong (reported, so NAKed); the repeat
+        // that started inside it is received on.
+        let (out, repeat) = burst(&[0x02, 0x01, 0xAA, 0xBB]);
+        assert_eq!(out.len(), 2, "{out:?}");
+        assert!(matches!(
+            &out[0],
+            Element::Frame {
+                checksum_ok: false,
+                ..
+            }
+        ));
+        assert!(
+            matches!(&out[1], Element::Frame { frame, checksum_ok: true, .. } if *frame == repeat)
+        );
+    }
 }
