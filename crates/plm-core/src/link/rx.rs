@@ -88,19 +88,32 @@ impl Receiver {
     }
 
     fn flush(&mut self, out: &mut Vec<Element>) {
-        // Cut short by T_IC: a whole right frame may start inside.
-        if self.partial == Partial::Frame && self.reported == 0 {
-            if let Some(q) = self.resync_at(true) {
+        if self.partial == Partial::Frame {
+            if self.reported > 0 && self.resync_at(false).is_none() {
+                self.afresh(self.last_byte_at, out);
+                return self.flush(out);
+            }
+            // Cut short by T_IC: a whole right frame may start inside.
+            if let Some(q) = self.resync_at(false) {
                 self.restart_at(q, out);
                 return self.flush(out);
             }
         }
-        // A frame started inside a bad one proved nothing: no NAK for it.
         let reason = match self.partial {
-            Partial::Frame | Partial::Status if self.reported == 0 => GarbageReason::Truncated,
+            Partial::Frame | Partial::Status => GarbageReason::Truncated,
             _ => GarbageReason::Unexpected,
         };
         self.garbage(reason, out);
+    }
+
+    /// The frame started inside a bad one is no frame either: the bytes
+    /// that came after the bad one are received afresh.
+    fn afresh(&mut self, at: Instant, out: &mut Vec<Element>) {
+        let rest = self.buf.split_off(self.reported.min(self.buf.len()));
+        self.clear();
+        for b in rest {
+            self.push(at, b, 0, out);
+        }
     }
 
     /// Reports the bytes not reported yet as garbage; nothing is partial.
@@ -119,15 +132,40 @@ impl Receiver {
     }
 
     /// Where, after its STX, a frame starts in the partial frame that is
-    /// whole with a right checksum (`whole`), or not whole yet.
-    fn resync_at(&self, whole: bool) -> Option<usize> {
+    /// whole with a right checksum, or (`incomplete`) not whole yet.
+    fn resync_at(&self, incomplete: bool) -> Option<usize> {
         (1..self.buf.len()).find(|&q| {
             self.dialect.is_stx(self.buf[q])
                 && match Frame::new_checked(&self.buf[q..], self.dialect) {
-                    Ok(f) => whole && f.checksum_ok(),
-                    Err(e) => !whole && matches!(e, FrameError::Truncated { .. }),
+                    Ok(f) => f.checksum_ok(),
+                    Err(e) => incomplete && matches!(e, FrameError::Truncated { .. }),
                 }
         })
+    }
+
+    /// After a whole frame that cannot be right (its first `reported`
+    /// bytes already reported): goes on from the first STX inside it
+    /// where a frame whole and right, or not whole yet, starts. False if
+    /// there is none.
+    fn resync_bad(&mut self, now: Instant, out: &mut Vec<Element>) -> bool {
+        let Some(q) = self.resync_at(true) else {
+            return false;
+        };
+        if q > self.reported {
+            out.push(Element::Garbage {
+                bytes: self.buf[self.reported..q].to_vec(),
+                reason: GarbageReason::Unexpected,
+            });
+        }
+        self.buf.drain(..q);
+        self.reported = self.reported.saturating_sub(q);
+        self.started_at = now;
+        if let Ok(f) = Frame::new_checked(&self.buf[..], self.dialect) {
+            out.push(Element::from_frame(&f));
+            self.reported = self.reported.max(f.total_len());
+            self.afresh(now, out);
+        }
+        true
     }
 
     /// Reports the bytes before `q` as garbage and receives the rest again
@@ -150,22 +188,25 @@ impl Receiver {
             Partial::Frame => {
                 self.buf.push(byte);
                 match Frame::new_checked(&self.buf[..], self.dialect) {
-                    Ok(f) if f.checksum_ok() || self.reported == 0 => {
+                    Ok(f) if f.checksum_ok() => {
                         out.push(Element::from_frame(&f));
-                        let n = self.buf.len();
-                        // A frame that cannot be right: one still coming
-                        // may have started inside it (the stall above).
-                        match (f.checksum_ok(), self.resync_at(false)) {
-                            (false, Some(q)) => {
-                                self.buf.drain(..q);
-                                self.reported = n - q;
-                                self.started_at = now;
-                            }
-                            _ => self.clear(),
+                        self.clear();
+                    }
+                    // A frame that cannot be right: one still coming may
+                    // have started inside it (the stall above).
+                    Ok(f) if self.reported == 0 => {
+                        out.push(Element::from_frame(&f));
+                        self.reported = self.buf.len();
+                        if !self.resync_bad(now, out) {
+                            self.clear();
                         }
                     }
-                    // Started inside a bad frame, and wrong too: garbage.
-                    Ok(_) => self.garbage(GarbageReason::Unexpected, out),
+                    // Started inside a bad frame, and wrong too.
+                    Ok(_) => {
+                        if !self.resync_bad(now, out) {
+                            self.afresh(now, out);
+                        }
+                    }
                     Err(FrameError::Truncated { .. }) => {}
                     Err(_) => {
                         // An impossible length byte: not a frame after all.
