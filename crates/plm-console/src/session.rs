@@ -39,6 +39,9 @@ pub const MAX_CATCH_UP: Duration = 100 * MS;
 /// next tick, so a simulated world the page cannot run in real time (a long
 /// street during discovery) slows down instead of freezing the page.
 pub const TICK_BUDGET_US: f64 = 12_000.0;
+/// How often the notes of what happened are handed out, µs of the page's
+/// clock: about one screen refresh.
+pub const SHOW_EVERY: f64 = 16_000.0;
 /// How long after its answer a request repeated for want of an ACK may
 /// still see a second answer.
 pub const DUPLICATE_GRACE: Duration = 200 * MS;
@@ -313,6 +316,8 @@ pub struct Session {
     ack_times: AckTimes,
     /// Requests in a row whose T_REQ went unanswered at least once.
     unanswered: u8,
+    /// When notes were last handed out, µs of the page's clock.
+    shown: f64,
     out: Tick,
 }
 
@@ -332,6 +337,7 @@ impl Session {
             page_now: 0,
             ack_times: AckTimes::default(),
             unanswered: 0,
+            shown: 0.0,
             out: Tick::default(),
         }
     }
@@ -439,6 +445,16 @@ impl Session {
             self.page_now = self.pacer.page_now();
             self.run_until(start, target, budget);
         }
+        // Replies at once; notes at most once per SHOW_EVERY (the page
+        // redraws no faster, and a redraw per frame on the line would hold
+        // up the next ACK).
+        if page_us < self.shown + SHOW_EVERY {
+            return Tick {
+                notes: Vec::new(),
+                replies: std::mem::take(&mut self.out.replies),
+            };
+        }
+        self.shown = page_us;
         self.take()
     }
 
@@ -463,9 +479,12 @@ impl Session {
         ])
     }
 
-    /// [`Session::next_due`] on the page's clock (µs).
+    /// [`Session::next_due`] on the page's clock (µs), or when notes held
+    /// back are due.
     pub fn next_wake(&self) -> Option<f64> {
-        self.next_due().and_then(|t| self.pacer.page_at(t))
+        let notes = (!self.out.notes.is_empty()).then_some(self.shown + SHOW_EVERY);
+        let due = self.next_due().and_then(|t| self.pacer.page_at(t));
+        [notes, due].into_iter().flatten().reduce(f64::min)
     }
 
     fn run_until(&mut self, start: Instant, target: Instant, budget: Budget) {
@@ -494,6 +513,12 @@ impl Session {
             self.start_next(next);
             self.drain(next);
             t = next;
+            // Answers go to their replies at the instant they came: a
+            // reply may send the next request, which then leaves at once
+            // rather than when the page next catches up.
+            if !self.out.replies.is_empty() {
+                break;
+            }
         }
     }
 
@@ -778,6 +803,50 @@ mod tests {
                 r(o);
             }
         }
+    }
+
+    /// Issue 13, "event-driven link": the session steps to what is due,
+    /// so a modem frame is ACKed at the instant its last byte arrives, and
+    /// a request sent from the reply of another leaves at the instant of
+    /// that reply: chained requests go as fast as queued ones, however
+    /// coarse the page's ticks (here 8 ms).
+    #[test]
+    fn frames_are_acked_and_chained_requests_sent_at_the_instant_they_are_due() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (1_000_000.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes);
+        let ping = || Command::PingRequest { data: vec![7; 8] };
+        let elapsed = |s: &mut Session, page: &mut f64, chained: bool| {
+            let seen = Seen::default();
+            let start = s.now();
+            let n = 20;
+            for _ in 0..if chained { 1 } else { n } {
+                s.request(ping(), reply(&seen));
+            }
+            let mut last = start;
+            while seen.borrow().len() < n {
+                *page += 8_000.0;
+                let t = s.tick(*page, Budget::UNLIMITED);
+                for (r, o) in t.replies {
+                    r(o);
+                    last = s.now();
+                    if chained && seen.borrow().len() < n {
+                        s.request(ping(), reply(&seen));
+                    }
+                }
+                assert!(*page < 2e7, "20 pings answered");
+            }
+            last - start
+        };
+        let queued = elapsed(&mut s, &mut page, false);
+        let chained = elapsed(&mut s, &mut page, true);
+        assert!(
+            chained * 100 <= queued * 105,
+            "chained {chained} µs vs queued {queued} µs"
+        );
+        let l = s.ack_latency();
+        assert!(l.count >= 40, "{l:?}");
+        assert_eq!(l.link.max, 0, "ACKed at the byte's arrival: {l:?}");
     }
 
     #[test]

@@ -35,7 +35,7 @@ pub const RESETN_PULSE_MS: u64 = 20;
 
 /// What to do when T_REQ gets no status message twice in a row over
 /// WebSerial (docs/console.md, "Real adapters").
-pub const TREQ_ADVICE: &str = "Two requests in a row had their T_REQ unanswered by the modem. On Windows, the usbser driver applies each RTS change one call late (a known WebSerial issue), so T_REQ never moves when the console asks: turn on \"Send each RTS change twice\" in the WebSerial panel and connect again. Otherwise check the T_REQ wiring (RTS) and its polarity.";
+pub const TREQ_ADVICE: &str = "Two requests in a row got no status message after T_REQ. On Windows, tick \"Send each RTS change twice\" in the WebSerial panel and connect again (its driver sets RTS one call late); else check the T_REQ wiring (RTS) and polarity.";
 
 /// The connection bar's state.
 #[derive(Clone, Copy)]

@@ -5,10 +5,11 @@
 //!
 //! Browsers clamp a `setTimeout` set from inside another timer's callback
 //! to 4 ms once five are nested, which is the whole budget of an ACK
-//! (UM0932 3.2.8). So the wake is always asked for through a
-//! `MessageChannel` message (a task of its own, never clamped), and the
-//! timer for a later deadline is set from that message's task, where timers
-//! do not nest. Natively (the tests) there is no page: nothing is run.
+//! (UM0932 3.2.8). So the wake is always asked for through a message the
+//! page posts to itself (`postMessage`: a task of its own, never clamped),
+//! and the timer for a later deadline is set from that message's task,
+//! where timers do not nest. Any message to the page looks whether
+//! something is due, which costs nothing when nothing is. Natively (the tests) there is no page: nothing is run.
 
 #[cfg(target_arch = "wasm32")]
 mod page {
@@ -16,8 +17,8 @@ mod page {
     use std::cell::RefCell;
     use std::rc::Rc;
     use wasm_bindgen::closure::Closure;
-    use wasm_bindgen::JsCast;
-    use web_sys::{MessageChannel, MessagePort};
+    use wasm_bindgen::{JsCast, JsValue};
+    use web_sys::Window;
 
     struct Waker {
         run: Rc<dyn Fn()>,
@@ -26,7 +27,7 @@ mod page {
         /// A message is on its way.
         posted: bool,
         timer: Option<i32>,
-        port: MessagePort,
+        window: Window,
         on_timer: Closure<dyn FnMut()>,
         _on_message: Closure<dyn FnMut()>,
     }
@@ -36,16 +37,15 @@ mod page {
     }
 
     pub fn install(run: Rc<dyn Fn()>) {
-        let Ok(channel) = MessageChannel::new() else {
+        let Some(window) = web_sys::window() else {
             return;
         };
         let on_message = Closure::<dyn FnMut()>::new(|| {
             with(|w| w.posted = false);
             arm();
         });
-        channel
-            .port1()
-            .set_onmessage(Some(on_message.as_ref().unchecked_ref()));
+        let _ =
+            window.add_event_listener_with_callback("message", on_message.as_ref().unchecked_ref());
         let on_timer = Closure::<dyn FnMut()>::new(|| {
             with(|w| w.timer = None);
             arm();
@@ -56,7 +56,7 @@ mod page {
                 due: f64::INFINITY,
                 posted: false,
                 timer: None,
-                port: channel.port2(),
+                window,
                 on_timer,
                 _on_message: on_message,
             })
@@ -77,13 +77,13 @@ mod page {
             }
             if w.due.is_finite() && w.timer.is_none() {
                 let ms = ((w.due - now) / 1_000.0).ceil() as i32;
-                w.timer = web_sys::window().and_then(|win| {
-                    win.set_timeout_with_callback_and_timeout_and_arguments_0(
+                w.timer = w
+                    .window
+                    .set_timeout_with_callback_and_timeout_and_arguments_0(
                         w.on_timer.as_ref().unchecked_ref(),
                         ms,
                     )
-                    .ok()
-                });
+                    .ok();
             }
             None
         });
@@ -98,11 +98,11 @@ mod page {
                 return;
             }
             w.due = page_us;
-            if let (Some(t), Some(win)) = (w.timer.take(), web_sys::window()) {
-                win.clear_timeout_with_handle(t);
+            if let Some(t) = w.timer.take() {
+                w.window.clear_timeout_with_handle(t);
             }
             if !w.posted {
-                w.posted = w.port.post_message(&wasm_bindgen::JsValue::NULL).is_ok();
+                w.posted = w.window.post_message(&JsValue::NULL, "*").is_ok();
             }
         });
     }

@@ -270,7 +270,7 @@ fn ResetCard() -> impl IntoView {
             </p>
             <button id="reset-send" on:click=reset>"Reset modem"</button>
             <label
-                title="Many USB-UART boards wire DTR to the modem's RESETN. Set, the console keeps DTR released and offers a hardware reset. Kept for this port."
+                title="DTR drives the modem's RESETN on this port (kept per port): DTR is kept released"
             >
                 <input
                     type="checkbox"
@@ -283,10 +283,10 @@ fn ResetCard() -> impl IntoView {
             <button
                 id="reset-resetn"
                 hidden=move || !c.conn.resetn_on_dtr.get()
-                title="Holds RESETN low (DTR asserted) for 20 ms: a power-on reset, factory MIB"
+                title="DTR asserted 20 ms: a hardware reset"
                 on:click=move |_| {
                     c.pulse_resetn();
-                    message.set(Some("RESETN pulsed (DTR): the modem boots; its BIO_ResetIndication follows.".into()));
+                    message.set(Some("RESETN pulsed: BIO_ResetIndication follows.".into()));
                 }
             >
                 "Reset modem (RESETN)"

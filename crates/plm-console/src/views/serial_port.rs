@@ -382,7 +382,7 @@ mod wasm {
                     </select>
                     <span></span>
                     <label
-                        title="Windows' usbser driver applies the RTS level of the call before (a known WebSerial issue): T_REQ then moves one step late and the modem never answers. Sending each change twice puts it right."
+                        title="Windows' usbser driver sets RTS one call late"
                     >
                         <input
                             type="checkbox"
