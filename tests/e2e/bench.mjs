@@ -9,7 +9,8 @@
 // - MIB-read round trips per second at 57600 baud versus the wire-time
 //   limit, computed from the bytes one exchange puts on the wire as the
 //   console's own traffic log shows them.
-// - gzip -9 sizes of the wasm, JS and CSS in dist/.
+// - gzip -9 sizes of the wasm, JS and CSS in dist/, against the budget,
+//   and where the bytes go (wasm-contributors.mjs).
 // - The Street view's frame time with a simulated street of 500 lamps
 //   (`?lamps=500`): requestAnimationFrame intervals while the console
 //   discovers and sweeps the street, against a 60 fps frame (16.7 ms).
@@ -23,6 +24,7 @@ import fs from 'node:fs/promises';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { artifacts, dist, launchChromium, serveDist, pageErrors } from './harness.mjs';
+import { releaseWasm, report } from './wasm-contributors.mjs';
 
 const READS = Number(process.env.PLM_BENCH_READS ?? 300);
 const WARM_UP = 20;
@@ -37,6 +39,8 @@ const STREET_LAMPS = 500;
 const STREET_MEASURE_MS = 20_000;
 /** One frame at 60 fps. */
 const FRAME_MS = 1000 / 60;
+/** The console's size budget, gzipped, everything included (DESIGN.md). */
+const BUDGET = 350 * 1024;
 
 
 const kib = (n) => `${(n / 1024).toFixed(1)} KiB`;
@@ -184,7 +188,9 @@ async function main() {
       '',
       'Size, gzip -9:',
       ...dsizes.map((r) => `  ${r.file.padEnd(40)} ${kib(r.raw).padStart(10)} -> ${kib(r.gz).padStart(9)}`),
-      `  ${'total'.padEnd(40)} ${kib(total.raw).padStart(10)} -> ${kib(total.gz).padStart(9)}`,
+      `  ${'total'.padEnd(40)} ${kib(total.raw).padStart(10)} -> ${kib(total.gz).padStart(9)}   (ratio ${(total.gz / BUDGET).toFixed(3)} of the ${kib(BUDGET)} budget)`,
+      '',
+      ...(releaseWasm() ? report(releaseWasm()) : ['Where the bytes go: no release wasm under target/ to read']),
       '',
     ];
     console.log(out.join('\n'));

@@ -142,6 +142,28 @@ v("SS_DataIndication and SS_SnifferIndication", "UM0932 3.3.21 Table 48, 3.3.22"
   frame(0x56, bytes([0x04, 0x05, 0, 0]) + b"\x01") + frame(0x5E, bytes([0x05, 0x05, 0, 0]) + b"\x02"),
   [F(command="SS_DataIndication", fields={"frame_modulation": "B-PSK coded", "ss_header_and_payload": "01"}),
    F(command="SS_SnifferIndication", fields={"frame_modulation": "Q-PSK coded", "ss_sdu": "02"})], "modem")
+# Tables 39 and 48: the SNR is signed, 255 "no meaning" for FSK frames only:
+# after a PSK frame FFh is -1 dB; MIB 04h (4.2.4) holds the same 4 bytes.
+v("SS_DataIndication Q-PSK: SNR FFh is -1 dB", "UM0932 3.3.21 Table 48", frame(0x56, bytes([0x01, 0xFF, 0, 0]) + b"\x01"),
+  [F(command="SS_DataIndication", fields={"frame_modulation": "Q-PSK", "snr": -1, "ss_header_and_payload": "01"})], "modem")
+v("MIB 04h after a B-PSK frame: SNR FFh is -1 dB", "UM0932 4.2.4 Table 39", frame(0x0C, b"\x04") + frame(0x0D, bytes([0x00, 0xFF, 0, 0])),
+  [F(command="MIB_ReadRequest"), F(command="MIB_ReadConfirm", fields={"frame_modulation": "B-PSK", "snr": -1})])
+# What the manual forbids is said in `warning`, the frame still decoded.
+v("a confirm from the host is not the host's to send", "UM0932 3.3, Table 11", frame(0x2D, b"\x01"),
+  [F(command="PingConfirm", fields={"data": "01"},
+     warning="PingConfirm comes from the ST7580, never from the host (UM0932 Tables 11, 12, 15)")], "host")
+v("a request from the modem is not the modem's to send", "UM0932 3.3, Table 10", frame(0x2C, b"\x01"),
+  [F(command="PingRequest", fields={"data": "01"},
+     warning="PingRequest is a request: only the host sends it (UM0932 Table 10)")], "modem")
+v("BIO_ResetConfirm data other than 00h", "UM0932 3.3.2", frame(0x3D, b"\x01"),
+  [F(command="BIO_ResetConfirm", fields={"confirm_data": 1},
+     warning="BIO_ResetConfirm data is always 00h, not 01h (UM0932 3.3.2)")], "modem")
+v("SS_DataRequest header length beyond the buffer", "UM0932 3.3.19 Table 45, Table 14", frame(0x54, bytes([0x00, 0x09]) + bytes(8)),
+  [F(command="SS_DataRequest", fields={"header_length": 9},
+     warning="the modem will refuse this request with Wrong parameter value (WPV): header length 9 is longer than the 8 bytes given")], "host")
+v("PHY_DataRequest gain byte with unused bits set", "UM0932 3.3.12 Table 35", frame(0x24, bytes([0x08, 0x35]) + b"\xaa"),
+  [F(command="PHY_DataRequest", fields={"tx_gain": 21, "unused": 1, "payload": "aa"},
+     warning="the modem will refuse this request with Wrong parameter value (WPV): tx_gain: 53 is out of range 0..=31 (bits 5-7 of the TX gain byte are unused: 0)")], "host")
 v("a frame hidden after a false start is found", "UM0932 3.2.6", bytes([0x02, 0xF0]) + frame(0x2C),
   [dict(kind="garbage"), F(command="PingRequest")], "host")
 

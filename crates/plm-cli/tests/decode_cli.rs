@@ -311,6 +311,7 @@ fn every_command_code_decodes_with_its_name_and_fields() {
         assert_eq!(v["checksum"], sum, "{ctx}");
         assert_eq!(v["hex"], hex(&bytes), "{ctx}");
         assert!(v.get("error").is_none(), "{ctx}");
+        assert!(v.get("warning").is_none(), "{ctx}");
         assert!(v.get("from").is_none(), "{ctx}");
         let got = fields(v);
         let want = expected.as_object().unwrap();
@@ -509,4 +510,109 @@ fn a_repeat_is_named_and_an_ack_after_it_is_late() {
     );
     // Absent, not false, where nothing is to be said.
     assert!(out[0].get("repeat").is_none() && out[3].get("after_t_ack").is_none());
+}
+
+/// UM0932 Tables 39 and 48: the SNR byte is signed, and 255 has "no
+/// meaning" for FSK frames only: after a PSK frame it is -1 dB.
+#[test]
+fn snr_ffh_is_minus_one_db_after_psk_and_no_value_after_fsk() {
+    for (modulation, want) in [
+        (Modulation::QPsk, json!(-1)),
+        (Modulation::BPskCodedPna, json!(-1)),
+        (Modulation::BFsk, Value::Null),
+    ] {
+        let cmd = Command::SsDataIndication(DataIndication {
+            info: info(modulation, 3, 0xFF, 0),
+            payload: vec![1, 2],
+        });
+        let v = &decode_st7580(&hex(&wire(&cmd)))[0];
+        assert_eq!(fields(v)["snr"], want, "{modulation:?}: {v}");
+    }
+}
+
+fn decode_from(from: &str, cmd: &Command) -> Value {
+    let out = decode(
+        &[
+            "decode",
+            "--chip",
+            "st7580",
+            "--from",
+            from,
+            &hex(&wire(cmd)),
+        ],
+        None,
+    );
+    assert_eq!(out.len(), 1, "{out:?}");
+    out[0].clone()
+}
+
+/// What UM0932 forbids is said in `warning`, and the frame is still
+/// decoded: a code sent the wrong way (3.3, Tables 10-15), a
+/// BIO_ResetConfirm whose data is not 00h (3.3.2), an SS_DataRequest
+/// against Table 45's header-length rules or a TX gain byte with its
+/// unused bits set (the rules the simulated modem refuses with).
+#[test]
+fn what_the_manual_forbids_is_a_warning_on_a_decoded_frame() {
+    let warning = |v: &Value| v["warning"].as_str().unwrap_or("").to_string();
+    let ping = Command::PingConfirm { data: vec![7] };
+    let v = decode_from("host", &ping);
+    assert_eq!(v["command"], "PingConfirm");
+    assert_eq!(fields(&v)["data"], "07");
+    assert!(warning(&v).contains("never from the host"), "{v}");
+    assert!(decode_from("modem", &ping).get("warning").is_none());
+    assert!(decode_st7580(&hex(&wire(&ping)))[0]
+        .get("warning")
+        .is_none());
+
+    let read = Command::MibReadRequest { index: 9 };
+    let v = decode_from("modem", &read);
+    assert_eq!(fields(&v)["object"], "Host interface timeout");
+    assert!(warning(&v).contains("only the host sends it"), "{v}");
+    assert!(decode_from("host", &read).get("warning").is_none());
+    let error = Command::MibReadError(ErrorCause::Busy);
+    assert!(warning(&decode_from("host", &error)).contains("MIB_ReadError comes from the ST7580"));
+
+    let reset = Command::BioResetConfirm { confirm_data: 0x01 };
+    let v = decode_from("modem", &reset);
+    assert_eq!(fields(&v)["confirm_data"], 1);
+    assert!(warning(&v).contains("always 00h, not 01h"), "{v}");
+    let reset = Command::BioResetConfirm { confirm_data: 0x00 };
+    assert!(decode_from("modem", &reset).get("warning").is_none());
+
+    let ss = |header_length, len: usize| {
+        Command::SsDataRequest(plm_core::st7580::SsDataRequest {
+            params: params(Modulation::QPsk, None, None),
+            header_length,
+            header_and_payload: vec![0x5A; len],
+        })
+    };
+    for (hl, len, says) in [
+        (
+            9,
+            8,
+            "Wrong parameter value (WPV): header length 9 is longer than the 8 bytes",
+        ),
+        (
+            3,
+            8,
+            "Wrong parameter value (WPV): header length 3 is below 4",
+        ),
+        (15, 15, "header length 15 is below 16"),
+    ] {
+        let v = decode_from("host", &ss(hl, len));
+        assert_eq!(fields(&v)["header_length"], hl, "{v}");
+        assert!(v.get("error").is_none(), "{v}");
+        assert!(warning(&v).contains(says), "{hl}/{len}: {v}");
+    }
+    // Tables 45 and 48: 226 bytes, whatever the DL CRC.
+    assert!(decode_from("host", &ss(4, 226)).get("warning").is_none());
+
+    let gain = Command::PhyDataRequest(DataRequest {
+        params: params(Modulation::BPsk, None, Some(0xE0 | 10)),
+        payload: vec![1],
+    });
+    let v = decode_from("host", &gain);
+    assert_eq!(fields(&v)["tx_gain"], 10);
+    assert_eq!(fields(&v)["unused"], 7);
+    assert!(warning(&v).contains("Wrong parameter value (WPV)"), "{v}");
 }

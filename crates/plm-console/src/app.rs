@@ -12,11 +12,6 @@ use crate::views::street::StreetView;
 use crate::views::traffic::TrafficView;
 use crate::views::update::UpdateView;
 use leptos::prelude::*;
-use std::time::Duration;
-
-/// How often the session catches up with the page's clock. Browsers clamp
-/// timers to about 4 ms; the session steps the link in 1 ms slices anyway.
-const TICK: Duration = Duration::from_millis(4);
 
 /// The views, in the order of the tabs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -116,9 +111,8 @@ pub fn App() -> impl IntoView {
     }
     console.connect_simulated();
     crate::bench_hook::install(console);
-    if let Ok(handle) = set_interval_with_handle(move || console.tick(), TICK) {
-        on_cleanup(move || handle.clear());
-    }
+    crate::wake::install(move || console.tick());
+    crate::wake::soon();
     let tab = RwSignal::new(Tab::from_hash(&current_hash()));
     let on_hash = window_event_listener(leptos::ev::hashchange, move |_| {
         tab.set(Tab::from_hash(&current_hash()));

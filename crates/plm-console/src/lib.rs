@@ -10,6 +10,8 @@
 //! - [`mibform`]: MIB forms read from plm-core's declarative description.
 //! - [`app`], [`stores`], [`views`]: the Leptos application.
 //! - [`bench_hook`]: `window.plmBench`, for `cargo xtask bench`.
+//! - [`wake`]: when the page runs the sessions (bytes, deadlines, the
+//!   user), instead of a fixed timer.
 
 pub mod fleet;
 pub mod mibform;
@@ -25,3 +27,4 @@ pub mod bench_hook;
 pub mod campaign_store;
 pub mod stores;
 pub mod views;
+pub mod wake;

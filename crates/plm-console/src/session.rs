@@ -78,6 +78,18 @@ impl Pacer {
     pub fn page_now(&self) -> Instant {
         self.page_now
     }
+
+    /// When the page's clock reaches the transport's instant `t` (µs of
+    /// the page's clock), as the last call mapped them.
+    pub fn page_at(&self, t: Instant) -> Option<f64> {
+        let speed = self.speed.max(1) as f64;
+        self.origin.map(|o| o + t as f64 / speed)
+    }
+}
+
+/// The earliest of some instants.
+pub fn earliest(times: impl IntoIterator<Item = Option<Instant>>) -> Option<Instant> {
+    times.into_iter().flatten().min()
 }
 
 /// When a tick must hand the page back (see [`TICK_BUDGET_US`]).
@@ -435,11 +447,34 @@ impl Session {
         std::mem::take(&mut self.out)
     }
 
+    /// The next instant on the transport's clock at which something is
+    /// due: an engine deadline, a request's answer timeout, the end of a
+    /// duplicate's grace, the transport's next event (a simulated byte
+    /// arriving), or now if a request waits to be sent.
+    pub fn next_due(&self) -> Option<Instant> {
+        let now = self.now();
+        let waiting = (self.active.is_none() && !self.queue.is_empty()).then_some(now);
+        earliest([
+            waiting,
+            self.host.poll_timeout(),
+            self.transport.as_ref().and_then(|t| t.next_event()),
+            self.active.as_ref().and_then(|a| a.deadline),
+            self.duplicate_of.map(|d| d.1),
+        ])
+    }
+
+    /// [`Session::next_due`] on the page's clock (µs).
+    pub fn next_wake(&self) -> Option<f64> {
+        self.next_due().and_then(|t| self.pacer.page_at(t))
+    }
+
     fn run_until(&mut self, start: Instant, target: Instant, budget: Budget) {
         let mut t = start;
         while t < target && !budget.spent() {
+            // Straight to the next thing due: a byte is taken, and ACKed,
+            // at the instant it arrives (UM0932 3.2.8, T_ACK).
             let mut next = (t + SLICE).min(target);
-            if let Some(d) = self.host.poll_timeout() {
+            if let Some(d) = self.next_due() {
                 if d > t && d < next {
                     next = d;
                 }
@@ -526,9 +561,8 @@ impl Session {
         }
     }
 
-    fn traffic(&mut self, at: Instant, element: &Element, from: &str) {
-        let mut decoded = self.decoder.decode(element);
-        decoded.from = Some(from.to_string());
+    fn traffic(&mut self, at: Instant, element: &Element, from: Source) {
+        let decoded = self.decoder.decode_from(from, element);
         self.out.notes.push(Note::Traffic {
             at: self.log_time(at),
             decoded: Box::new(decoded),
@@ -544,7 +578,7 @@ impl Session {
                         self.out.notes.push(Note::Status { at, byte });
                     }
                 }
-                self.traffic(now, &el, "modem");
+                self.traffic(now, &el, Source::Modem);
             }
             Event::Sent(el) => {
                 if matches!(el, Element::Ack) {
@@ -557,7 +591,7 @@ impl Session {
                         self.page_now.max(written).saturating_sub(now),
                     );
                 }
-                self.traffic(now, &el, "host")
+                self.traffic(now, &el, Source::Host)
             }
             Event::Frame(f) => self.on_frame(now, f),
             Event::Repeat(_) => {}

@@ -25,6 +25,10 @@ pub const SIM_SEED: u64 = 7580;
 /// Line events kept for the Simulator view.
 pub const LINE_EVENTS: usize = 200;
 
+/// The longest the page sleeps with nothing due, µs: within the session's
+/// catch-up limit, so that a simulated world keeps the page's time.
+pub const IDLE_WAKE_US: f64 = 50_000.0;
+
 /// How long a hardware reset holds RESETN low (DTR asserted). UM0932
 /// gives no minimum; 20 ms is far beyond any reset filter.
 pub const RESETN_PULSE_MS: u64 = 20;
@@ -147,8 +151,9 @@ impl StreetStore {
     }
 
     /// Acts on the street session; the console shows what changed at
-    /// its next tick.
+    /// its next tick, which comes at once.
     pub fn act<R>(&self, f: impl FnOnce(&mut StreetSession) -> R) -> R {
+        crate::wake::soon();
         f(&mut self.session().borrow_mut())
     }
 }
@@ -478,7 +483,8 @@ impl Console {
         self.session().borrow().ack_latency()
     }
 
-    /// Lets time pass up to the page's clock: called by the page's timer.
+    /// Lets time pass up to the page's clock, then asks to be run again
+    /// when something is next due ([`crate::wake`]).
     pub fn tick(&self) {
         let budget = || Budget::wall(page_now_us, TICK_BUDGET_US);
         let tick = self.session().borrow_mut().tick(page_now_us(), budget());
@@ -490,10 +496,21 @@ impl Console {
             .tick(page_now_us(), budget());
         self.apply_street(street);
         self.refresh_sim();
+        let now = page_now_us();
+        let due = [
+            self.session().borrow().next_wake(),
+            self.street.session().borrow().next_wake(),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(now + IDLE_WAKE_US, f64::min);
+        crate::wake::at(due);
     }
 
-    /// Applies what happened without letting time pass.
+    /// Applies what happened without letting time pass, and has the
+    /// sessions run at once (a request may wait to be sent).
     fn refresh(&self) {
+        crate::wake::soon();
         let tick = self.session().borrow_mut().take();
         let street = self.street.session().borrow_mut().take();
         let (state, kind, port) = self.with_active(|t, state| {

@@ -330,19 +330,30 @@ impl StreetSession {
         self.run_within(start, target, Budget::UNLIMITED);
     }
 
+    /// The next instant on the transport's clock at which something is
+    /// due: the concentrator's, the discovery's, the sweep's and the
+    /// update's deadlines, and the transport's next event.
+    pub fn next_due(&self) -> Option<Instant> {
+        crate::session::earliest([
+            self.conc.poll_timeout(),
+            self.discovery.as_ref().and_then(|d| d.poll_timeout()),
+            self.next_sweep,
+            self.update_timeout(),
+            self.transport.as_ref().and_then(|t| t.next_event()),
+        ])
+    }
+
+    /// [`StreetSession::next_due`] on the page's clock (µs).
+    pub fn next_wake(&self) -> Option<f64> {
+        self.next_due().and_then(|t| self.pacer.page_at(t))
+    }
+
     fn run_within(&mut self, start: Instant, target: Instant, budget: Budget) {
         let mut t = start;
         while t < target && !budget.spent() {
             let mut next = (t + crate::session::SLICE).min(target);
-            for d in [
-                self.conc.poll_timeout(),
-                self.discovery.as_ref().and_then(|d| d.poll_timeout()),
-                self.next_sweep,
-                self.update_timeout(),
-            ] {
-                if let Some(d) = d.filter(|d| *d > t && *d < next) {
-                    next = d;
-                }
+            if let Some(d) = self.next_due().filter(|d| *d > t && *d < next) {
+                next = d;
             }
             let Some(transport) = self.transport.as_mut() else {
                 return;

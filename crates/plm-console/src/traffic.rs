@@ -97,6 +97,9 @@ pub fn summary(d: &Decoded) -> String {
     if let Some(e) = &d.error {
         parts.push(format!("error: {e}"));
     }
+    if let Some(w) = &d.warning {
+        parts.push(format!("warning: {w}"));
+    }
     parts.join("  ")
 }
 
@@ -289,6 +292,17 @@ mod tests {
             log.push(Some(1_000 * i as u64), d);
         }
         log
+    }
+
+    #[test]
+    fn the_summary_says_what_the_manual_forbids() {
+        // BIO_ResetConfirm with data 01h (UM0932 3.3.2: always 00h).
+        let d = &elements(Source::Modem, "02 01 3d 01 3f 00")[0];
+        assert!(
+            summary(d).contains("warning: BIO_ResetConfirm data is always 00h"),
+            "{}",
+            summary(d)
+        );
     }
 
     #[test]

@@ -8,6 +8,10 @@
 //!   for an unknown code), `checksum`, `checksum_ok`, and `fields` named
 //!   after the manual's labels in snake_case;
 //! - `error` when the data does not fit the command, `reason` for garbage;
+//! - ST7580: `warning` when UM0932 forbids what a frame that decodes says
+//!   (a request from the modem or a confirm, error or indication from the
+//!   host under `--from`, a BIO_ResetConfirm whose data is not 00h, a data
+//!   request the modem refuses, by `st7580::validate::check_request`);
 //! - ST7580: `repeat: true` on a frame with STX 03h (the modem's repeat,
 //!   UM0932 3.2.7), and `after_t_ack: true` on the host's ACK that the
 //!   capture shows came after that repeat had started, so after T_ACK (the
@@ -74,6 +78,10 @@ pub struct Decoded {
     /// frame it answers, so after T_ACK (UM0932 3.2.7); known only from a
     /// capture of both directions.
     pub after_t_ack: Option<bool>,
+    /// ST7580: what UM0932 forbids of a frame that still decodes (a code
+    /// sent the wrong way, a BIO_ResetConfirm whose data is not 00h, a
+    /// data request the modem refuses); several are joined by "; ".
+    pub warning: Option<String>,
 }
 
 // The object `plm decode` prints, and the console exports and imports.
@@ -93,6 +101,7 @@ json_record!(Decoded {
     reason,
     repeat,
     after_t_ack,
+    warning,
 });
 
 /// A field value as JSON: numbers as numbers, enums by the manual's name,
@@ -149,7 +158,7 @@ impl Chip {
     /// Command name, layer, fields and error of a frame sent by `from`.
     fn frame(&mut self, from: Source, frame: &LocalFrame, d: &mut Decoded) {
         match self {
-            Chip::St7580(c) => c.frame(frame, d),
+            Chip::St7580(c) => c.frame(from, frame, d),
             #[cfg(feature = "st7570")]
             Chip::St7570(c) => c.frame(from, frame, d),
             #[cfg(not(feature = "st7570"))]
@@ -244,9 +253,15 @@ impl Decoder {
 
     /// Decodes one element (updating the context).
     pub fn decode(&mut self, e: &Element) -> Decoded {
+        self.decode_from(self.source, e)
+    }
+
+    /// Decodes one element sent by `source`: for a driver that sees both
+    /// directions, as the console's session does (one context for both).
+    pub fn decode_from(&mut self, source: Source, e: &Element) -> Decoded {
         let mut d = Decoded {
             kind: e.kind().to_string(),
-            from: match self.source {
+            from: match source {
                 Source::Host => Some("host".into()),
                 Source::Modem => Some("modem".into()),
                 Source::Any => None,
@@ -264,6 +279,7 @@ impl Decoder {
             reason: None,
             repeat: None,
             after_t_ack: None,
+            warning: None,
         };
         if self.dialect == Dialect::St7580 {
             self.repeats(e, &mut d);
@@ -279,7 +295,7 @@ impl Decoder {
                 d.code = Some(frame.code);
                 d.checksum = Some(*checksum);
                 d.checksum_ok = Some(*checksum_ok);
-                self.chip.frame(self.source, frame, &mut d);
+                self.chip.frame(source, frame, &mut d);
             }
             Element::Status(s) => self.chip.status(s.data(), &mut d),
             Element::Garbage { reason, .. } => {
@@ -334,4 +350,22 @@ pub fn decode_all(dialect: Dialect, source: Source, bytes: &[u8]) -> Vec<Decoded
     d.push(bytes);
     d.finish();
     core::iter::from_fn(|| d.next()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_decoder_for_both_directions_knows_who_sent_each_element() {
+        // PingConfirm (UM0932 Table 11): the modem's to send, not the host's.
+        let mut d = Decoder::new(Dialect::St7580, Source::Any);
+        d.push(&hex::parse("02 01 2d 07 35 00").unwrap());
+        let e = d.stream.next().unwrap();
+        assert_eq!(d.decode(&e).warning, None);
+        let host = d.decode_from(Source::Host, &e);
+        assert_eq!(host.from.as_deref(), Some("host"));
+        assert!(host.warning.unwrap().contains("never from the host"));
+        assert_eq!(d.decode_from(Source::Modem, &e).warning, None);
+    }
 }

@@ -144,6 +144,7 @@ impl AppDecoded {
             reason: None,
             repeat: None,
             after_t_ack: None,
+            warning: None,
         }
     }
 

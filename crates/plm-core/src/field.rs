@@ -64,6 +64,10 @@ pub struct Field {
     /// A raw value that means "no value" (UM0932 Table 39: SNR 255 for
     /// FSK frames); it reads as [`Value::Absent`].
     pub absent: Option<u64>,
+    /// When set, `absent` means "no value" only while this other field of
+    /// the same bytes holds this value (Table 39: SNR 255 has no meaning
+    /// for FSK frames only; for PSK frames it is -1 dB).
+    pub absent_if: Option<(&'static Field, i64)>,
 }
 
 /// A decoded field value.
@@ -151,6 +155,7 @@ impl Field {
             max: 0,
             settable: true,
             absent: None,
+            absent_if: None,
         }
     }
 
@@ -253,6 +258,14 @@ impl Field {
         self
     }
 
+    /// The same field with a raw value that means "no value" only while
+    /// `other` holds `value`.
+    pub const fn absent_when_with(mut self, raw: u64, other: &'static Field, value: i64) -> Field {
+        self.absent = Some(raw);
+        self.absent_if = Some((other, value));
+        self
+    }
+
     /// The same field with another byte order.
     pub const fn order(mut self, order: Order) -> Field {
         self.order = order;
@@ -312,7 +325,12 @@ impl Field {
 
     /// Reads the field as a typed [`Value`]; `None` if `data` is too short.
     pub fn read(&self, data: &[u8]) -> Option<Value> {
-        if self.absent.is_some() && self.raw(data) == self.absent {
+        if self.absent.is_some()
+            && self.raw(data) == self.absent
+            && self
+                .absent_if
+                .is_none_or(|(other, value)| other.get(data) == Some(value))
+        {
             return Some(Value::Absent);
         }
         Some(match self.kind {

@@ -9,7 +9,7 @@ use harness::{
     Fault, Part, Sim, PING_CNF, PING_REQ,
 };
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
-use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Transmit};
+use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Transmit, BUSY_LIMIT};
 use plm_core::link::{
     Dialect, Element, GarbageReason, LocalFrame, Stx, TicSelector, Timeouts, ACK,
 };
@@ -450,11 +450,18 @@ fn gap_in_host_frame_is_dropped_by_device_and_host_retries() {
             }
         )
     );
-    // No answer at all to the broken frame: the only things the device
-    // sent are the two statuses, one ACK (the restarted frame) and the
-    // confirm.
-    let sent: Vec<&str> = sim.dev_sent().iter().map(|(_, e)| e.kind()).collect();
-    assert_eq!(sent, ["status", "status", "ack", "frame"]);
+    // UM0932 3.2.8, "in other cases, it answers with a NAK": the frame
+    // cut short is NAKed as T_IC ends it, and the host restarts at once
+    // instead of waiting out T_ACK. Then the second status, the ACK of
+    // the restarted frame and the confirm.
+    let sent = sim.dev_sent();
+    let kinds: Vec<&str> = sent.iter().map(|(_, e)| e.kind()).collect();
+    assert_eq!(kinds, ["status", "nak", "status", "ack", "frame"]);
+    assert_eq!(sent[1].0, f0[3].at + T_IC);
+    assert_eq!(
+        sim.dev_events_where(|e| *e == DeviceEvent::FrameCut).len(),
+        1
+    );
     let e = sim.host_events_where(|e| is_retry(e) || is_failed(e) || is_delivered(e));
     assert_eq!(
         e.iter().map(|(_, e)| e.clone()).collect::<Vec<_>>(),
@@ -462,7 +469,7 @@ fn gap_in_host_frame_is_dropped_by_device_and_host_retries() {
             Event::Retry {
                 ticket,
                 attempt: 1,
-                cause: LinkError::NoAck
+                cause: LinkError::Nak
             },
             Event::Delivered(ticket)
         ]
@@ -497,15 +504,20 @@ fn gap_in_modem_frame_is_dropped_by_host_and_repeat_accepted() {
             })
         )
     );
-    // The host answers nothing to the broken frame; its only byte is the
-    // ACK of the repeat.
+    // The host NAKs the frame cut short as T_IC ends it (3.2.7: "In other
+    // cases, it answers with a NAK"), then ACKs the repeat.
     let repeat = sim.frame_bytes(Dir::DevToHost, 1);
     assert_eq!(repeat[0].sent, 0x03);
-    let h2d: Vec<_> = sim.wire(Dir::HostToDev).copied().collect();
-    assert_eq!(h2d.len(), 1);
+    let h2d: Vec<_> = sim
+        .wire(Dir::HostToDev)
+        .map(|w| (w.part, w.start))
+        .collect();
     assert_eq!(
-        (h2d[0].part, h2d[0].start),
-        (Part::Ack, repeat.last().unwrap().at)
+        h2d,
+        vec![
+            (Part::Nak, f0[3].at + T_IC),
+            (Part::Ack, repeat.last().unwrap().at)
+        ]
     );
     // The device repeated T_ACK after the frame as far as it knew (it does
     // not see its own UART stall).
@@ -1268,7 +1280,7 @@ fn host_retries_a_not_now_status_with_a_new_edge_and_takes_the_modem_frame_first
     let b1 = b(BAUD);
     let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
     // Bits 1-2 of the status: transmission or reception in progress.
-    sim.host.set_not_now(0b0000_0110);
+    sim.host.set_not_now(0b0000_0110, 0);
     sim.dev
         .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x02]));
     let req = ping();
@@ -1314,4 +1326,95 @@ fn host_retries_a_not_now_status_with_a_new_edge_and_takes_the_modem_frame_first
     let ind_start = sim.frame_start(Dir::DevToHost, 0);
     assert!(ind_start < 2 * MS + wire_time(4, BAUD), "{ind_start}");
     assert!(sim.host_frames().contains(&confirm(&req)));
+}
+
+// ---- 11. status availability (issue 13, point 2) ------------------------
+
+/// UM0932 Table 8 bit 1: a power line frame is being transmitted.
+fn status_transmitting() -> plm_core::link::StatusMessage {
+    plm_core::link::StatusMessage::new(Dialect::St7580, &[0x02])
+}
+
+#[test]
+fn modem_takes_no_frame_after_a_not_now_status() {
+    // A host that sends whatever the status says (no "not now" bits).
+    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
+    sim.host.set_not_now(0, T_IC);
+    sim.dev.set_status(status_transmitting());
+    let req = ping();
+    let ticket = sim.submit(req.clone());
+    sim.run_until(30 * MS);
+    // 3.2.8: the status did not confirm the data channel's availability;
+    // the frame is ignored like one outside T_SR: no ACK, no NAK.
+    assert!(sim.wire(Dir::HostToDev).next().is_some(), "the host sent");
+    assert!(sim.requests().is_empty());
+    assert!(sim.dev_sent().iter().all(|(_, e)| e.kind() == "status"));
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0]));
+    sim.run_to_idle();
+    assert_eq!(sim.requests(), vec![req]);
+    let e = sim.host_events_where(|e| is_retry(e) || is_delivered(e));
+    assert_eq!(
+        e.iter().map(|(_, e)| e.clone()).collect::<Vec<_>>(),
+        vec![
+            Event::Retry {
+                ticket,
+                attempt: 1,
+                cause: LinkError::NoAck
+            },
+            Event::Delivered(ticket)
+        ]
+    );
+}
+
+#[test]
+fn host_waits_for_a_status_that_is_not_not_now() {
+    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
+    sim.dev.set_status(status_transmitting());
+    let req = ping();
+    let ticket = sim.submit(req.clone());
+    sim.run_until(100 * MS);
+    // By default bits 1-2 are "not now": T_REQ released before any byte,
+    // pulled low again T_IC later; nothing sent, no attempt spent.
+    assert!(sim.wire(Dir::HostToDev).next().is_none(), "no frame yet");
+    let edges: Vec<Instant> = sim
+        .treq
+        .iter()
+        .filter(|(_, a)| *a)
+        .map(|(t, _)| *t)
+        .collect();
+    assert!((8..=11).contains(&edges.len()), "{edges:?}");
+    assert!(edges.windows(2).all(|w| w[1] - w[0] >= T_IC), "{edges:?}");
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0]));
+    sim.run_to_idle();
+    assert_eq!(sim.requests(), vec![req]);
+    assert_eq!(
+        sim.host_events_where(|e| is_retry(e) || is_failed(e) || is_delivered(e))
+            .into_iter()
+            .map(|(_, e)| e)
+            .collect::<Vec<_>>(),
+        vec![Event::Delivered(ticket)]
+    );
+}
+
+#[test]
+fn host_gives_up_on_a_modem_busy_for_good() {
+    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
+    // Bit 2: a power line frame is being received, for ever.
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x04]));
+    let ticket = sim.submit(ping());
+    sim.run_until(3_000 * MS);
+    let failed = sim.host_events_where(is_failed);
+    assert_eq!(failed.len(), 1);
+    assert_eq!(failed[0].1, Event::Failed(ticket, LinkError::Busy));
+    let at = failed[0].0;
+    assert!(
+        (BUSY_LIMIT..BUSY_LIMIT + T_IC + MS).contains(&at),
+        "failed at {at}"
+    );
+    assert!(sim.host_events_where(is_retry).is_empty());
+    assert_eq!(sim.host.pending(), 0);
+    assert!(sim.requests().is_empty());
 }

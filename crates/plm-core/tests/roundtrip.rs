@@ -489,28 +489,20 @@ fn used_bits(code: u8, data: &[u8]) -> Vec<u8> {
             mask[0] = 0x7F;
             mask[1] = 0x7F;
         }
-        // Tables 35/45: bits 5-7 of the TX gain byte unused.
-        PHY_DATA_REQUEST | DL_DATA_REQUEST | SS_DATA_REQUEST if data[0] & 0x08 != 0 => {
-            mask[1 + 3 * (data[0] & 1) as usize] = 0x1F;
-        }
         _ => {}
     }
     mask
 }
 
-/// Codes whose data has no unused bit at all: the re-emitted data must be
-/// the input, byte for byte.
+/// Codes whose data has no unused bit the parsed command drops: the
+/// re-emitted data must be the input, byte for byte. Requests keep the
+/// unused bits of their TX gain byte (Tables 35/45), for validation to
+/// refuse them.
 fn without_unused_bits(code: u8) -> bool {
     use code::*;
     !matches!(
         code,
-        BIO_RESET_INDICATION
-            | PHY_DATA_CONFIRM
-            | DL_DATA_CONFIRM
-            | SS_DATA_CONFIRM
-            | PHY_DATA_REQUEST
-            | DL_DATA_REQUEST
-            | SS_DATA_REQUEST
+        BIO_RESET_INDICATION | PHY_DATA_CONFIRM | DL_DATA_CONFIRM | SS_DATA_CONFIRM
     )
 }
 

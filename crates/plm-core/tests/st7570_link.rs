@@ -452,7 +452,7 @@ fn the_modems_t_ic_follows_000bh_the_baud_rate_and_a_reset() {
 }
 
 #[test]
-fn a_gap_in_a_modem_frame_loses_it_because_silence_counts_as_ack() {
+fn a_gap_in_a_modem_frame_is_naked_and_repeated_not_lost() {
     let mut sim = sim();
     let ind = indication(0);
     sim.inject(Dir::DevToHost, Some(1), Fault::Delay(2 * MS), |c| {
@@ -473,22 +473,34 @@ fn a_gap_in_a_modem_frame_loses_it_because_silence_counts_as_ack() {
             })
         )
     );
-    // The host answers nothing; the modem takes the silence for an ACK
-    // (UM 5.2.2) T_ACK after the frame as it sent it: no repeat.
-    assert_eq!(sim.wire(Dir::HostToDev).count(), 0);
-    assert_eq!(frames_sent(&sim, Dir::DevToHost), 1);
+    // The host NAKs the frame cut short as T_IC ends it (UM 5.2.2: "In
+    // other cases, it answers with an NAK"; issue 13, point 5), after the
+    // frame's end as the modem sent it, so the modem repeats it T_WBC
+    // later; silence would have counted as ACK and lost it.
     let sent_end = wire_time(emit(&ind).len(), BAUD);
+    let nak = f0[3].at + T_IC;
+    assert!(nak > sent_end);
+    let h2d: Vec<_> = sim
+        .wire(Dir::HostToDev)
+        .map(|w| (w.part, w.start))
+        .collect();
+    assert_eq!(h2d[0], (Part::Nak, nak));
+    assert_eq!(h2d[1].0, Part::Ack);
+    assert_eq!(h2d.len(), 2);
+    assert_eq!(frames_sent(&sim, Dir::DevToHost), 2);
+    let repeat = sim.frame_bytes(Dir::DevToHost, 1);
+    assert_eq!(repeat[0].start, nak + b() + T_WBC);
     assert_eq!(
         delivered_by_dev(&sim),
         vec![(
-            sent_end + T_ACK,
+            repeat[0].start,
             DeviceEvent::Delivered {
-                frame: ind,
-                repeated: false
+                frame: ind.clone(),
+                repeated: true
             }
         )]
     );
-    assert!(sim.host_frames().is_empty());
+    assert_eq!(sim.host_frames(), vec![ind]);
 }
 
 // ---- 5. T_ACK and NAK from the modem ----------------------------------------------

@@ -246,18 +246,15 @@ impl Flash {
 
     /// The newest good record and its copy, then the other good one.
     fn records(&self) -> (Option<Found>, Option<Found>) {
-        let mut good: Vec<Found> = self
-            .copies
-            .iter()
-            .enumerate()
-            .filter_map(|(i, c)| match c {
-                Copy::Good { record, tried } => Some((i, *record, *tried)),
-                _ => None,
-            })
-            .collect();
-        good.sort_by_key(|g| core::cmp::Reverse(g.1.seq));
-        let mut it = good.into_iter();
-        (it.next(), it.next())
+        let mut good = self.copies.iter().enumerate().filter_map(|(i, c)| match c {
+            Copy::Good { record, tried } => Some((i, *record, *tried)),
+            _ => None,
+        });
+        // Two copies: no sort needed (and none linked into the console).
+        match (good.next(), good.next()) {
+            (Some(a), Some(b)) if b.1.seq > a.1.seq => (Some(b), Some(a)),
+            pair => pair,
+        }
     }
 
     /// What runs now: the last start's choice.

@@ -338,15 +338,23 @@ impl St7580 {
         };
         let mc = self.modem_config();
         let psdu = &rx.psdu;
-        // The length byte, then as many bytes as it announces.
-        let declared = psdu.first().copied().unwrap_or(0) as usize;
+        // The length byte, then as many bytes as it announces; an SS
+        // frame's CRC follows them, uncounted (`plc::ss_frame`).
+        let dl = DlOptions::from_modem_config(&mc);
+        let uncounted = if mc.access_mode == 2 { dl.crc.len() } else { 0 };
+        let declared = psdu.first().copied().unwrap_or(0) as usize + uncounted;
         let frame = &psdu[..(1 + declared).min(psdu.len())];
         let body = frame.get(1..).unwrap_or_default();
         let ind = |payload: Vec<u8>| DataIndication { info, payload };
         let out = match mc.access_mode {
             0 => Some(Command::PhyDataIndication(ind(body.to_vec()))),
             mode => {
-                match plc::dl_open(&DlOptions::from_modem_config(&mc), frame) {
+                let opened = if mode == 1 {
+                    plc::dl_open(&dl, frame)
+                } else {
+                    plc::ss_frame_open(&dl, frame)
+                };
+                match opened {
                     Ok(DlReceived::Good { payload }) => {
                         self.bump(index::DL_DATA, 0);
                         if mode == 1 {
@@ -536,7 +544,7 @@ impl St7580 {
                 self.rng.fill(&mut iv);
                 let sdu = plc::ss_seal(&key, &iv, r.header_length as usize, &r.header_and_payload)
                     .map_err(|_| ErrorCause::WrongParameterLength)?;
-                let psdu = plc::dl_frame(&DlOptions::from_modem_config(&mc), &sdu)
+                let psdu = plc::ss_frame(&DlOptions::from_modem_config(&mc), &sdu)
                     .map_err(|_| ErrorCause::WrongParameterLength)?;
                 self.start_tx(now, Layer::Ss, r.params, psdu);
                 None

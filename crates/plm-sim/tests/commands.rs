@@ -2,11 +2,12 @@
 //! of UM0932 Table 10, with the confirms, errors (Table 14) and indications
 //! the manual gives.
 
-use plm_core::link::LocalFrame;
+use plm_core::link::host::{Event, LinkError};
+use plm_core::link::{Element, LocalFrame};
 use plm_core::st7580::mib::{index, MibObject, ModemConfig, PhyConfig};
 use plm_core::st7580::{
-    ActiveLayer, Command, DataRequest, ErrorCause, Modulation, ResetCause, Status, Temperature,
-    TxParams,
+    code, ActiveLayer, Command, DataRequest, ErrorCause, Modulation, ResetCause, Status,
+    Temperature, TxParams,
 };
 use plm_core::time::MS;
 use plm_sim::{Fault, HostDriver, Outcome, Sim, SimConfig};
@@ -184,25 +185,49 @@ fn status_message_carries_live_bits() {
     let s = status(&d);
     assert!(!s.configuration_status);
     assert_eq!(s.active_layer, ActiveLayer::Ss);
-    // During a transmission: transmitting, and data requests are Busy.
+    // During a transmission the status says so (Table 8 bit 1), which is
+    // "not now" (UM0932 3.2.8, docs/protocol-notes.md "Status message
+    // availability"): the modem takes no frame and the host waits, so a
+    // second data request is no longer refused with Busy: it goes out
+    // after the first one's confirm, and the MIB read behind it too.
     let long = phy(&[0x55; 200], Modulation::BPskCoded);
     d.submit(&Command::PhyDataRequest(long.clone()));
     d.run_for(30 * MS);
+    let start = d.events.len();
+    d.submit(&Command::PhyDataRequest(long));
+    let timeouts = plm_core::st7580::mib::object(9).expect("09h").default;
+    assert_eq!(read(&mut d, 9), timeouts.to_vec());
+    let seen: Vec<&Event> = d.events[start..].iter().map(|(_, e)| e).collect();
+    let busy = seen
+        .iter()
+        .filter(|e| matches!(e, Event::Received(Element::Status(s)) if Status::from_message(s).transmitting))
+        .count();
+    assert!(busy > 10, "{busy} statuses said transmitting");
+    let sent = |c: u8| {
+        seen.iter()
+            .position(|e| matches!(e, Event::Sent(Element::Frame { frame, .. }) if frame.code == c))
+    };
+    let confirmed = seen
+        .iter()
+        .position(|e| matches!(e, Event::Frame(f) if f.code == code::PHY_DATA_CONFIRM))
+        .expect("PHY_DataConfirm at the end of the transmission");
+    assert!(sent(code::PHY_DATA_REQUEST).expect("the second data request") > confirmed);
+    assert!(
+        seen.iter()
+            .all(|e| !matches!(e, Event::Frame(f) if f.code == code::PHY_DATA_ERROR)),
+        "no PHY_DataError"
+    );
+    let confirms = seen
+        .iter()
+        .filter(|e| matches!(e, Event::Frame(f) if f.code == code::PHY_DATA_CONFIRM))
+        .count();
     assert_eq!(
-        answer(&mut d, Command::PhyDataRequest(long)),
-        Command::PhyDataError(ErrorCause::Busy)
+        confirms, 2,
+        "both transmissions confirmed before the MIB read"
     );
-    assert!(status(&d).transmitting);
-    // MIB requests are still served while transmitting.
-    assert_eq!(read(&mut d, 0x0A), vec![0x00, 0x42, 0x00, 0x97]);
-    let c = d.run_until(
-        1_000 * MS,
-        |e| matches!(e, plm_core::link::host::Event::Frame(f) if f.code == 0x25),
-    );
-    assert!(c, "PHY_DataConfirm at the end of the transmission");
-    // 06h: one transmitted, one refused.
+    // 06h: two transmitted, none refused.
     let counters = read(&mut d, 6);
-    assert_eq!(&counters[4..8], &[0, 1, 0, 1]);
+    assert_eq!(&counters[4..8], &[0, 2, 0, 0]);
 }
 
 #[test]
@@ -276,4 +301,48 @@ fn mib_09h_changes_the_timeouts() {
     let ch = plm_core::time::wire_time(1, sim.baud());
     assert_eq!(gap - ch, 10 * MS);
     assert_eq!(got.len(), 13, "one repeat only");
+}
+
+#[test]
+fn a_transmitting_modem_takes_no_frame_from_a_host_that_ignores_the_status() {
+    // A host that sends whatever the status says (issue 13, point 2).
+    let mut d = driver(1);
+    d.host.set_not_now(0, 10 * MS);
+    let long = phy(&[0x55; 200], Modulation::BPskCoded);
+    d.submit(&Command::PhyDataRequest(long));
+    d.run_for(10 * MS);
+    // Acked, the transmission runs for about 350 ms. A ping now is sent
+    // after a status with bit 1 set: the modem ignores it (UM0932 3.2.8,
+    // like a frame outside T_SR): no ACK, no NAK, every attempt.
+    let start = d.events.len();
+    let ticket = d.submit(&Command::PingRequest { data: vec![7] });
+    d.run_until(
+        2_000 * MS,
+        |e| matches!(e, Event::Delivered(t) | Event::Failed(t, _) if *t == ticket),
+    );
+    let seen: Vec<&Event> = d.events[start..].iter().map(|(_, e)| e).collect();
+    let no_acks = seen
+        .iter()
+        .filter(|e| {
+            matches!(
+                e,
+                Event::Retry {
+                    cause: LinkError::NoAck,
+                    ..
+                }
+            )
+        })
+        .count();
+    assert_eq!(no_acks, 2, "{seen:#?}");
+    assert!(seen.contains(&&Event::Failed(ticket, LinkError::NoAck)));
+    assert!(!seen
+        .iter()
+        .any(|e| matches!(e, Event::Received(Element::Nak))));
+    // Three attempts within the transmission: none executed.
+    d.run_for(500 * MS);
+    let pings = d.events[start..]
+        .iter()
+        .filter(|(_, e)| matches!(e, Event::Frame(f) if f.code == code::PING_CONFIRM))
+        .count();
+    assert_eq!(pings, 0);
 }

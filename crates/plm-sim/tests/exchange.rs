@@ -175,6 +175,30 @@ fn every_crc_option_with_and_without_the_phy_length() {
     }
 }
 
+/// UM0932 Tables 45 and 48: 226 bytes of SS header and payload, whatever
+/// the CRC of MIB 00h (the SS frame's length byte does not count it).
+#[test]
+fn ss_frames_of_226_bytes_travel_with_every_crc() {
+    for crc in 0..4 {
+        let mut d = street(2, mc(2, crc, crc == 3, false), LineConfig::default());
+        let data: Vec<u8> = (0..226u32).map(|i| (i * 7) as u8).collect();
+        confirmed(
+            &mut d,
+            Command::SsDataRequest(SsDataRequest {
+                params: TxParams::default(),
+                header_length: 16,
+                header_and_payload: data.clone(),
+            }),
+        );
+        let got = indication(&mut d, 2_000 * MS).expect("echo");
+        assert!(
+            matches!(got, Command::SsDataIndication(_)),
+            "CRC {crc}: {got:?}"
+        );
+        assert_eq!(payload(&got).1, &data[..], "CRC {crc}");
+    }
+}
+
 /// A frame that cannot be read: a DL frame whose CRC is wrong for the
 /// receiver, an SS frame under another key. With the sniffer flag on, the
 /// sniffer indication; with it off, nothing (Figure 5).

@@ -17,7 +17,7 @@
 //! position is exact.
 
 use plm_core::link::host::{Event, LinkError, Ticket, Transmit};
-use plm_core::link::{Element, Stx};
+use plm_core::link::{Element, Stx, ACK, NAK};
 use plm_core::st7580::{
     code, Command, DataRequest, ErrorCause, ResetCause, ResetData, Status, Temperature, TxParams,
 };
@@ -204,10 +204,18 @@ fn ping_with_fault(dir: Dir, k: usize, fault: Fault) -> Exchange {
 fn dropped_host_byte_is_never_answered_and_the_host_retries() {
     for k in 0..FRAME {
         let ex = ping_with_fault(Dir::HostToModem, k, Fault::DropByte(Dir::HostToModem));
-        // A frame one byte short waits for a byte that never comes: the
-        // modem drops it at T_IC, says nothing, the host times out.
-        assert_eq!(ex.retries(), vec![LinkError::NoAck], "byte {k}: {ex:#?}");
-        assert_eq!(ex.naks_received(), 0, "byte {k}");
+        // A frame one byte short waits for a byte that never comes: T_IC
+        // ends it, the modem NAKs it (UM0932 3.2.8, "in other cases"), the
+        // host restarts. Without its STX, T_REQ went high before any
+        // frame began: the wait is over, the bytes are ignored, the host
+        // times out.
+        let cause = if k == 0 {
+            LinkError::NoAck
+        } else {
+            LinkError::Nak
+        };
+        assert_eq!(ex.retries(), vec![cause], "byte {k}: {ex:#?}");
+        assert_eq!(ex.naks_received(), usize::from(k > 0), "byte {k}");
         assert_eq!(ex.confirms(&DATA), vec![Stx::First], "byte {k}: {ex:#?}");
         assert_eq!(ex.repeats(), 0, "byte {k}");
     }
@@ -221,16 +229,17 @@ fn corrupted_host_byte_is_naked_or_dropped_and_the_host_retries() {
             k,
             Fault::CorruptByte(Dir::HostToModem, 0x80),
         );
-        // A damaged STX or length byte leaves no frame to NAK (the modem
-        // waits for bytes that never come); any later byte breaks the
-        // checksum.
-        let cause = if k < 2 {
+        // A damaged STX: no frame began before T_REQ went high, the
+        // bytes are ignored, the host times out. A damaged length byte
+        // leaves a frame waiting for bytes that never come: NAKed as T_IC
+        // ends it; any later byte breaks the checksum: NAKed.
+        let cause = if k == 0 {
             LinkError::NoAck
         } else {
             LinkError::Nak
         };
         assert_eq!(ex.retries(), vec![cause], "byte {k}: {ex:#?}");
-        assert_eq!(ex.naks_received(), usize::from(k >= 2), "byte {k}");
+        assert_eq!(ex.naks_received(), usize::from(k > 0), "byte {k}");
         // Executed once: the damaged frame was not taken.
         assert_eq!(ex.confirms(&DATA), vec![Stx::First], "byte {k}: {ex:#?}");
     }
@@ -257,8 +266,9 @@ fn host_byte_delayed_past_t_ic_breaks_the_frame_and_the_host_retries() {
             k,
             Fault::DelayByte(Dir::HostToModem, PAST_T_IC),
         );
-        assert_eq!(ex.retries(), vec![LinkError::NoAck], "byte {k}: {ex:#?}");
-        assert_eq!(ex.naks_received(), 0, "byte {k}");
+        // Cut short by T_IC: NAKed; the late tail is ignored.
+        assert_eq!(ex.retries(), vec![LinkError::Nak], "byte {k}: {ex:#?}");
+        assert_eq!(ex.naks_received(), 1, "byte {k}");
         assert_eq!(ex.confirms(&DATA), vec![Stx::First], "byte {k}: {ex:#?}");
     }
 }
@@ -274,7 +284,7 @@ fn host_byte_delayed_past_t_ack_costs_one_attempt_only() {
             k,
             Fault::DelayByte(Dir::HostToModem, PAST_T_ACK),
         );
-        assert_eq!(ex.retries(), vec![LinkError::NoAck], "byte {k}: {ex:#?}");
+        assert_eq!(ex.retries(), vec![LinkError::Nak], "byte {k}: {ex:#?}");
         assert_eq!(ex.confirms(&DATA), vec![Stx::First], "byte {k}: {ex:#?}");
     }
 }
@@ -324,9 +334,10 @@ fn dropped_modem_byte_in_a_frame_is_repeated_with_stx_03() {
     for k in M2H_CONFIRM..M2H_CONFIRM + FRAME {
         let ex = ping_with_fault(Dir::ModemToHost, k, Fault::DropByte(Dir::ModemToHost));
         assert_eq!(ex.retries(), vec![], "byte {k}: {ex:#?}");
-        // The host drops the short frame at T_IC without a word; the
-        // modem's STX 03h repeat is the first good copy: a frame, once.
-        assert_eq!(ex.naks_sent(), 0, "byte {k}");
+        // The host NAKs the short frame as T_IC ends it (without its STX,
+        // the length byte 03h starts one); the modem's STX 03h repeat is
+        // the first good copy: a frame, once.
+        assert_eq!(ex.naks_sent(), 1, "byte {k}");
         assert_eq!(ex.confirms(&DATA), vec![Stx::Repeat], "byte {k}: {ex:#?}");
         assert_eq!(ex.repeats(), 0, "byte {k}");
     }
@@ -341,8 +352,9 @@ fn corrupted_modem_byte_in_a_frame_is_naked_and_repeated_with_stx_03() {
             Fault::CorruptByte(Dir::ModemToHost, 0x80),
         );
         assert_eq!(ex.retries(), vec![], "byte {k}: {ex:#?}");
-        let nak = k >= M2H_CONFIRM + 2;
-        assert_eq!(ex.naks_sent(), usize::from(nak), "byte {k}: {ex:#?}");
+        // A bad checksum, or a frame cut short (a damaged STX: the
+        // length byte 03h starts one; a damaged length): one NAK.
+        assert_eq!(ex.naks_sent(), 1, "byte {k}: {ex:#?}");
         assert_eq!(ex.confirms(&DATA), vec![Stx::Repeat], "byte {k}: {ex:#?}");
         assert_eq!(ex.repeats(), 0, "byte {k}");
     }
@@ -357,7 +369,10 @@ fn modem_byte_delayed_past_t_ic_breaks_the_frame_and_the_repeat_gets_through() {
             Fault::DelayByte(Dir::ModemToHost, PAST_T_IC),
         );
         assert_eq!(ex.retries(), vec![], "byte {k}: {ex:#?}");
-        assert_eq!(ex.naks_sent(), 0, "byte {k}");
+        // The head cut short by T_IC is NAKed, and so is the tail when
+        // it starts with 03h (the length byte) and is cut short too.
+        let naks = 1 + usize::from(k == M2H_CONFIRM + 1);
+        assert_eq!(ex.naks_sent(), naks, "byte {k}");
         assert_eq!(ex.confirms(&DATA), vec![Stx::Repeat], "byte {k}: {ex:#?}");
     }
     // A stall before the STX delays the frame as a whole: it is whole.
@@ -370,16 +385,14 @@ fn modem_byte_delayed_past_t_ic_breaks_the_frame_and_the_repeat_gets_through() {
 }
 
 #[test]
-#[ignore = "plm-sim models a stall on the modem's wire the modem does not know of: its repeat queues behind the tail"]
 fn modem_byte_delayed_past_t_ack_still_lets_the_repeat_through() {
-    // A confirm stalled past T_ACK: the modem writes its STX 03h repeat
-    // T_ACK after the end it computed, so the repeat queues right behind
-    // the stalled tail with no T_IC gap. When the tail holds a 02h/03h
-    // (here the length byte, or the data byte 02h), the host's receiver
-    // starts a frame there and swallows the repeat: the confirm is lost
-    // though the modem counts the repeat as delivered. A real modem can
-    // only pause its own UART, and would count T_ACK from its real last
-    // byte.
+    // A confirm stalled past T_ACK (a USB adapter holding bytes back):
+    // the modem writes its STX 03h repeat T_ACK after the end it
+    // computed, so the repeat arrives right behind the stalled tail with
+    // no T_IC gap. When the tail holds a 02h/03h (here the length byte,
+    // or the data byte 02h), the host's receiver starts a frame there;
+    // that frame cannot be right, and the receiver finds the repeat
+    // inside it (docs/protocol-notes.md, "Known limits").
     let data = [0x11, 0x02, 0x33];
     for k in M2H_CONFIRM + 1..M2H_CONFIRM + FRAME {
         let mut d = powered(1, 57_600);
@@ -697,7 +710,12 @@ impl Hit {
 fn hit(delays: &'static [Duration]) -> impl Strategy<Value = Hit> {
     prop_oneof![
         Just(Hit::Drop),
-        (1u8..=255).prop_map(Hit::Corrupt),
+        // 13h turns a NAK into an ACK (15h ^ 13h = 06h): the host takes a
+        // refused frame for delivered, which no link rule can catch
+        // (docs/protocol-notes.md, "Known limits").
+        (1u8..=255)
+            .prop_filter("NAK into ACK", |m| *m != ACK ^ NAK)
+            .prop_map(Hit::Corrupt),
         prop::sample::select(delays).prop_map(Hit::Delay),
     ]
 }
@@ -705,9 +723,10 @@ fn hit(delays: &'static [Duration]) -> impl Strategy<Value = Hit> {
 /// Stalls of the property, host to modem.
 const H2M_DELAYS: &[Duration] = &[PAST_T_IC, PAST_T_ACK];
 /// Stalls of the property, modem to host. Past T_ACK the modem's repeat
-/// queues right behind the stalled tail (see the ignored test
-/// `modem_byte_delayed_past_t_ack_still_lets_the_repeat_through`).
-const M2H_DELAYS: &[Duration] = &[PAST_T_IC];
+/// arrives right behind the stalled tail, and the host's receiver finds
+/// it by content (`modem_byte_delayed_past_t_ack_still_lets_the_repeat_through`);
+/// 150 ms is ten times FTDI's default latency timer.
+const M2H_DELAYS: &[Duration] = &[PAST_T_IC, PAST_T_ACK, 150 * MS];
 
 /// One ping of the property: a pause, the payload after the ping's
 /// number, and at most one fault each way (`usize`: where, reduced

@@ -762,3 +762,44 @@ fn a_phy_monitor_searches_slot_by_slot_until_it_hears_a_subframe() {
         matches!(&spy[1], Command::SpySubframeIndication(s) if s.p_sdu == [7; 38] && s.snr1 == 7)
     );
 }
+
+/// ST7570 UM 5.3.26: a host frame whose length "has not been respected"
+/// (cut short by T_IC) gets CMD_SyntaxError(01h), not a NAK (a NAK is
+/// for a wrong checksum). Issue 13, point 5.
+#[test]
+fn a_host_frame_cut_short_gets_cmd_syntax_error_not_nak() {
+    use plm_core::link::{Dialect, LocalFrame, ACK};
+    use plm_sim::st7570::St7570;
+    let mut m = St7570::new(57_600, 0);
+    let drain = |m: &mut St7570, until: u64| {
+        let mut out = Vec::new();
+        while let Some(t) = m.poll_timeout().filter(|t| *t <= until) {
+            m.handle_timeout(t);
+        }
+        while let Some(b) = m.poll_transmit() {
+            out.extend(b);
+        }
+        out
+    };
+    // The reset indication first; ACK it.
+    let _ = drain(&mut m, 5 * MS);
+    m.handle_rx(5 * MS, &[ACK]);
+    let _ = drain(&mut m, 60 * MS);
+    m.set_treq(60 * MS, true);
+    let status = drain(&mut m, 60 * MS);
+    assert_eq!(status.first(), Some(&0x3F), "{status:02x?}");
+    // A CMD_ReadDBRequest with its last two bytes missing.
+    let req = LocalFrame::new(0x10, vec![0x00, 0x0B])
+        .emit(Dialect::St7570)
+        .unwrap();
+    m.handle_rx(61 * MS, &req[..1]);
+    m.set_treq(61 * MS, false);
+    m.handle_rx(61 * MS + 200, &req[1..req.len() - 2]);
+    let out = drain(&mut m, 100 * MS);
+    let syntax = Command::SyntaxError { error: 0x01 }
+        .to_frame()
+        .emit(Dialect::St7570)
+        .unwrap();
+    // T_IC after the last byte: the frame, and nothing else (no NAK).
+    assert_eq!(out, syntax, "{out:02x?}");
+}

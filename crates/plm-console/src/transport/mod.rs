@@ -61,6 +61,12 @@ pub trait Transport {
     /// Lets time run up to `until` (no further than the clock allows) and
     /// returns the bytes received meanwhile, with their arrival times.
     fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)>;
+    /// The next instant anything happens behind the transport, when it
+    /// knows (a simulated world does; a real port says so by waking the
+    /// page when bytes come, [`crate::wake::soon`]).
+    fn next_event(&self) -> Option<Instant> {
+        None
+    }
     /// The simulated world behind this transport, if it is one.
     fn simulator(&mut self) -> Option<&mut dyn Simulator> {
         None

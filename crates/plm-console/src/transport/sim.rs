@@ -94,6 +94,10 @@ impl Transport for SimTransport {
         self.sim.inject(Fault::Resetn(asserted));
     }
 
+    fn next_event(&self) -> Option<Instant> {
+        self.sim.next_deadline()
+    }
+
     fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)> {
         self.sim.advance_to(until);
         self.sim.host_read()

@@ -538,6 +538,7 @@ async fn read_loop(
                     .borrow_mut()
                     .rx
                     .extend(chunk.into_iter().map(|b| (at, b)));
+                crate::wake::soon();
             }
             Err(e) => {
                 // Web Serial: after a non-fatal error (framing, parity,

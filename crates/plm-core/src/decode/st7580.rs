@@ -5,10 +5,13 @@
 
 use super::{put_hex, put_layout, Decoded};
 use crate::json::{Json, Object};
-use crate::link::LocalFrame;
+use crate::link::{LocalFrame, Source};
+use crate::st7580::code::CommandType;
 use crate::st7580::fields::{indication_data, reset_data, status as status_fields, tx_options};
-use crate::st7580::{self, code as c, Command};
+use crate::st7580::{self, code as c, validate, Command};
+use alloc::format;
 use alloc::string::{String, ToString};
+use alloc::vec::Vec;
 
 /// What an ST7580 frame needs from the frames before it.
 #[derive(Debug, Clone, Default)]
@@ -31,18 +34,24 @@ impl Context {
         self.pending_read = Some(index);
     }
 
-    /// Command name, fields and error of a frame.
-    pub(super) fn frame(&mut self, frame: &LocalFrame, d: &mut Decoded) {
+    /// Command name, fields, error and warning of a frame sent by `from`.
+    pub(super) fn frame(&mut self, from: Source, frame: &LocalFrame, d: &mut Decoded) {
         d.command = Some(c::name(frame.code).map_or(Json::Null, |n| Json::String(n.into())));
         let mut fields = Object::new();
+        let mut warnings = Vec::new();
+        warnings.extend(direction(from, frame.code));
         match Command::parse(frame.code, &frame.data) {
-            Ok(cmd) => d.error = self.command_fields(&cmd, &frame.data, &mut fields),
+            Ok(cmd) => {
+                d.error = self.command_fields(&cmd, &frame.data, &mut fields);
+                warnings.extend(forbidden(&cmd));
+            }
             Err(err) => {
                 put_hex(&mut fields, "data", &frame.data);
                 d.error = Some(err.to_string());
             }
         }
         d.fields = Some(fields);
+        d.warning = (!warnings.is_empty()).then(|| warnings.join("; "));
     }
 
     /// Fills `f` with the named fields of `cmd`; returns what the modem
@@ -131,6 +140,42 @@ impl Context {
     }
 }
 
+/// A code sent the wrong way (UM0932 3.3, Tables 10-15): the host sends
+/// requests only, the modem everything else.
+fn direction(from: Source, code: u8) -> Option<String> {
+    let t = c::command_type(code)?;
+    let name = c::name(code)?;
+    match (from, t) {
+        (Source::Modem, CommandType::Request) => Some(format!(
+            "{name} is a request: only the host sends it (UM0932 Table 10)"
+        )),
+        (Source::Host, CommandType::Request) | (Source::Any, _) | (Source::Modem, _) => None,
+        (Source::Host, _) => Some(format!(
+            "{name} comes from the ST7580, never from the host (UM0932 Tables 11, 12, 15)"
+        )),
+    }
+}
+
+/// What UM0932 forbids in a command that parses: a BIO_ResetConfirm whose
+/// data is not 00h (3.3.2), a data request the modem refuses
+/// (`validate::check_request`, the simulated modem's rule). The DL CRC
+/// length is not in the stream: 1 byte, the option that fits the most, so
+/// that only what every configuration refuses is said.
+fn forbidden(cmd: &Command) -> Option<String> {
+    match cmd {
+        Command::BioResetConfirm { confirm_data } if *confirm_data != 0 => Some(format!(
+            "BIO_ResetConfirm data is always 00h, not {confirm_data:02X}h (UM0932 3.3.2)"
+        )),
+        Command::PhyDataRequest(_) | Command::DlDataRequest(_) | Command::SsDataRequest(_) => {
+            validate::check_request(cmd, 1).err().map(|r| {
+                let cause = r.cause.name().unwrap_or("an error");
+                format!("the modem will refuse this request with {cause}: {r}")
+            })
+        }
+        _ => None,
+    }
+}
+
 /// Index, object name and fields of a MIB value; a problem if the value
 /// does not fit the object.
 fn put_object(f: &mut Object, index: u8, data: &[u8]) -> Option<String> {
@@ -170,6 +215,6 @@ fn put_tx_params(f: &mut Object, bytes: &[u8], p: &st7580::TxParams) {
         f.insert(tx_options::TX_FREQUENCY.name, Json::from(hz));
     }
     if let Some(g) = p.tx_gain {
-        f.insert(tx_options::TX_GAIN.name, Json::from(g));
+        put_layout(f, tx_options::GAIN_BYTE, &[g]);
     }
 }

@@ -4,12 +4,14 @@
 //! Rules implemented (UM0932 3.2.5-3.2.9; ST7570 UM 5.2.2-5.2.3, where
 //! the chips differ the [`Dialect`] says how):
 //! - on T_REQ low, answer with the status message as soon as not busy;
-//!   accept the host's frame only if its STX comes within T_SR; T_REQ
+//!   accept the host's frame only if its STX comes within T_SR of a status
+//!   that is not "not now" ([`Dialect::not_now_bits`]); T_REQ
 //!   released before that STX ends the wait at once, and a new falling
 //!   edge is answered like the first;
 //! - send a frame that became ready while the host's frame was awaited as
 //!   soon as that wait ends, before the status of a later T_REQ;
-//! - ACK a frame with right length and checksum, NAK any other;
+//! - ACK a frame with right length and checksum, NAK any other, including
+//!   one cut short by T_IC (ST7570: CMD_SyntaxError instead, by its model);
 //! - send frames with STX 02h unprompted (the modem is master);
 //! - repeat a frame once as [`Dialect::modem_reaction`] says (ST7580: on
 //!   NAK, any other frame or no ACK within T_ACK, with STX 03h T_ACK after
@@ -21,7 +23,7 @@
 
 use super::dialect::{Answer, Reaction};
 use super::host::Transmit;
-use super::rx::Receiver;
+use super::rx::{is_cut_frame, Receiver};
 use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, TicSelector, Timeouts};
 use crate::time::{earliest, Instant, TxClock};
 use alloc::collections::VecDeque;
@@ -36,6 +38,10 @@ pub enum DeviceEvent {
     Sent(Element),
     /// A host frame was accepted and acknowledged: a request to execute.
     Request(LocalFrame),
+    /// A host frame the modem took was cut short by T_IC (UM0932 3.2.6):
+    /// the ST7580 engine has answered NAK; the ST7570 model answers with
+    /// CMD_SyntaxError ([`Dialect::modem_naks_cut_frame`]).
+    FrameCut,
     /// A frame the device sent was acknowledged, or counted as such by the
     /// dialect's rule (`repeated`: only after its repeat, which counts as
     /// acknowledged by rule).
@@ -385,6 +391,15 @@ impl DeviceEngine {
                     self.send(now, Element::Nak);
                 }
             }
+            // A frame the modem took, cut short by T_IC: NAK (3.2.8), or
+            // the ST7570's CMD_SyntaxError, which its model sends.
+            (_, e) if self.host_frame_open && is_cut_frame(self.dialect, &e) => {
+                self.host_frame_open = false;
+                if self.dialect.modem_naks_cut_frame() {
+                    self.send(now, Element::Nak);
+                }
+                self.events.push_back(DeviceEvent::FrameCut);
+            }
             (_, Element::Garbage { .. }) => self.host_frame_open = false,
             _ => {}
         }
@@ -406,10 +421,16 @@ impl DeviceEngine {
             self.treq_served = true;
             let status = Element::Status(self.status);
             let end = self.send(now, status);
-            self.state = State::AwaitHostFrame {
-                deadline: end + self.timeouts.t_sr,
-            };
-            return;
+            // UM0932 3.2.8: only a status confirming the data channel's
+            // availability opens the T_SR wait; after a "not now" a host
+            // frame is ignored like one outside T_SR, and the modem stays
+            // master of the port.
+            if !self.dialect.not_now(&self.status) {
+                self.state = State::AwaitHostFrame {
+                    deadline: end + self.timeouts.t_sr,
+                };
+                return;
+            }
         }
         if let Some(frame) = self.queue.pop_front() {
             self.send_queued(now, frame);

@@ -3,7 +3,7 @@
 //! layout, status length, how long the host waits for the status message,
 //! and when and how the modem repeats a frame.
 
-use super::{Stx, Timeouts};
+use super::{StatusMessage, Stx, Timeouts};
 use crate::time::{wire_time, Duration, Instant};
 
 /// Which chip's host-interface rules apply.
@@ -144,6 +144,37 @@ impl Dialect {
                 (from, from + t.t_wbc)
             }
         }
+    }
+
+    /// Bits of the status message's first data byte that mean "not now":
+    /// the status does not confirm the data channel's availability
+    /// (UM0932 3.2.5, 3.2.8). ST7580: Table 8 bits 1 and 2, a power line
+    /// frame being transmitted or received. ST7570: none; Table 11 has no
+    /// such bit and its BUSY is the PHY layer's state (docs/protocol-notes.md,
+    /// "ST7570: link").
+    pub const fn not_now_bits(self) -> u8 {
+        match self {
+            Dialect::St7580 => 0b0000_0110,
+            Dialect::St7570 => 0,
+        }
+    }
+
+    /// Whether `status` says "not now" ([`Dialect::not_now_bits`]).
+    pub fn not_now(self, status: &StatusMessage) -> bool {
+        status
+            .data()
+            .first()
+            .is_some_and(|b| b & self.not_now_bits() != 0)
+    }
+
+    /// Whether the modem answers a host frame cut short by T_IC with NAK
+    /// (UM0932 3.2.8: "In other cases, it answers with a NAK"). The
+    /// ST7570 answers it with a CMD_SyntaxError frame instead (ST7570 UM
+    /// 5.3.26: "the value declared in the length field has not been
+    /// respected"; NAK only for a wrong checksum), which its model sends
+    /// on [`super::device::DeviceEvent::FrameCut`].
+    pub const fn modem_naks_cut_frame(self) -> bool {
+        matches!(self, Dialect::St7580)
     }
 
     /// Short name, as the CLI spells it.

@@ -10,7 +10,7 @@
 //! - expect ACK within T_ACK of the frame's last byte; on NAK or silence
 //!   restart the whole sequence, at most `max_attempts` times;
 //! - ACK every modem frame with a right length and checksum, NAK the
-//!   others; the modem's repeat of a frame just accepted (ST7580: STX 03h;
+//!   others (one cut short by T_IC too); the modem's repeat of a frame just accepted (ST7580: STX 03h;
 //!   ST7570: the same frame T_WBC after the ACK, which it took for a NAK)
 //!   is acknowledged but not reported again;
 //! - drop a frame whose characters are more than T_IC apart.
@@ -18,9 +18,9 @@
 //! Decisions where the seeds are silent are in docs/protocol-notes.md
 //! ("Host link engine", "ST7570: link").
 
-use super::rx::Receiver;
+use super::rx::{is_cut_frame, Receiver};
 use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
-use crate::time::{earliest, Instant, TxClock};
+use crate::time::{earliest, Duration, Instant, TxClock, MS};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
@@ -51,7 +51,15 @@ pub enum LinkError {
     NoAck,
     /// The frame cannot be emitted (too long for the dialect).
     Unencodable,
+    /// Every status said "not now" for [`BUSY_LIMIT`].
+    Busy,
 }
+
+/// How long a frame waits for a status that is not "not now" before it
+/// fails with [`LinkError::Busy`]: longer than the longest power line
+/// frame the ST7580 sends or receives (255 bytes of B-FSK at 1200 bps,
+/// about 1.8 s), so that only a modem stuck busy makes a frame fail.
+pub const BUSY_LIMIT: Duration = 2_000 * MS;
 
 impl core::fmt::Display for LinkError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -60,6 +68,7 @@ impl core::fmt::Display for LinkError {
             LinkError::Nak => "the modem refused the frame (NAK) on every attempt: check the baud rate",
             LinkError::NoAck => "the modem did not acknowledge the frame within T_ACK: check the baud rate and the cable",
             LinkError::Unencodable => "the frame is too long for a local frame",
+            LinkError::Busy => "the modem said it was transmitting or receiving on the power line on every status message for 2 s",
         })
     }
 }
@@ -152,6 +161,8 @@ struct Pending {
     bytes: Vec<u8>,
     frame: LocalFrame,
     attempts: u8,
+    /// The first "not now" status for this frame.
+    busy_since: Option<Instant>,
 }
 
 /// The host-side link engine.
@@ -170,9 +181,11 @@ pub struct HostEngine {
     /// the repeat (UM0932 3.2.7, ST7570 UM 5.2.2).
     last_accepted: Option<Accepted>,
     last_status: Option<StatusMessage>,
-    /// Bits of the status message's first data byte that mean "not now"
-    /// (see [`HostEngine::set_not_now`]); 0: any status is permission.
+    /// Bits of the status message's first data byte that mean "not now",
+    /// and how long T_REQ stays released after one (see
+    /// [`HostEngine::set_not_now`]).
     not_now: u8,
+    again_after: Duration,
     /// When the UART will have sent every byte written so far: T_ACK runs
     /// from the frame's last byte on the wire (UM0932 3.2.8), which is later
     /// than its own length says when an ACK was written just before it.
@@ -194,7 +207,8 @@ impl HostEngine {
             events: VecDeque::new(),
             last_accepted: None,
             last_status: None,
-            not_now: 0,
+            not_now: dialect.not_now_bits(),
+            again_after: config.timeouts.t_ic,
             tx_clock: TxClock::default(),
         }
     }
@@ -212,14 +226,16 @@ impl HostEngine {
     /// Takes a status message whose first data byte has one of the `mask`
     /// bits set as "not now" (UM0932 3.2.8: the status "confirms or not"
     /// the data channel availability): T_REQ is released before any byte
-    /// of the frame, which ends the modem's wait, and pulled low again at
-    /// once, a new falling edge the modem answers like the first. A frame
-    /// the modem had ready meanwhile comes first (the wait for the status
-    /// restarts on every modem byte). Not an attempt: the frame was not
-    /// sent. 0 (the default): any status is permission, see
-    /// docs/protocol-notes.md "Status message availability".
-    pub fn set_not_now(&mut self, mask: u8) {
+    /// of the frame, which ends the modem's wait, and pulled low again
+    /// `again_after` later, a new falling edge the modem answers like the
+    /// first. A frame the modem sends meanwhile is taken as any other. Not
+    /// an attempt: the frame was not sent; after [`BUSY_LIMIT`] of "not
+    /// now" it fails with [`LinkError::Busy`]. Default:
+    /// [`Dialect::not_now_bits`] and T_IC, see docs/protocol-notes.md
+    /// "Status message availability".
+    pub fn set_not_now(&mut self, mask: u8, again_after: Duration) {
         self.not_now = mask;
+        self.again_after = again_after;
     }
 
     /// The last status message received.
@@ -243,6 +259,7 @@ impl HostEngine {
                 bytes,
                 frame,
                 attempts: 0,
+                busy_since: None,
             }),
             Err(_) => self
                 .events
@@ -386,14 +403,22 @@ impl HostEngine {
                 self.last_status = Some(s);
                 if let State::AwaitStatus { .. } = self.state {
                     let not_now = s.data().first().is_some_and(|b| b & self.not_now != 0);
-                    if not_now && self.current.is_some() {
-                        self.transmits.push_back(Transmit::TReq { asserted: false });
-                        self.transmits.push_back(Transmit::TReq { asserted: true });
-                        self.state = State::AwaitStatus {
-                            deadline: now + self.dialect.status_wait(&self.config.timeouts),
-                        };
-                    } else {
-                        self.send_current(now);
+                    match &mut self.current {
+                        Some(p) if not_now => {
+                            self.transmits.push_back(Transmit::TReq { asserted: false });
+                            let since = *p.busy_since.get_or_insert(now);
+                            if now - since >= BUSY_LIMIT {
+                                p.attempts = self.config.max_attempts;
+                                self.attempt_failed(now, LinkError::Busy);
+                                return;
+                            }
+                            // Not an attempt: `advance` counts it again.
+                            p.attempts -= 1;
+                            self.state = State::Idle {
+                                not_before: now + self.again_after,
+                            };
+                        }
+                        _ => self.send_current(now),
                     }
                 }
             }
@@ -410,9 +435,14 @@ impl HostEngine {
                     self.attempt_failed(now, LinkError::Nak);
                 }
             }
-            Element::Garbage { .. } => {
-                // A broken frame from the modem: it will repeat it.
+            e => {
+                // A broken frame from the modem: it will repeat it. One cut
+                // short by T_IC is NAKed (UM0932 3.2.7: "In other cases, it
+                // answers with a NAK"; ST7570 UM 5.2.2 alike).
                 self.last_accepted = None;
+                if is_cut_frame(self.dialect, &e) {
+                    self.send(now, Element::Nak);
+                }
             }
         }
     }

@@ -187,6 +187,11 @@ pub mod tx_options {
         .unit("Hz");
     /// Byte 4 (or 1) when the gain selector is 1 (offset relative).
     pub const TX_GAIN: Field = Field::bits_uint("tx_gain", "TX gain", 0, 0, 5);
+    /// Bits 5-7 of the TX gain byte, "Unused": written 0, a request with
+    /// one set is refused (see protocol notes, "Reserved and unused bits").
+    pub const TX_GAIN_UNUSED: Field = Field::reserved("unused", "Unused", 0, 5, 3);
+    /// The TX gain byte of Tables 35 and 45.
+    pub const GAIN_BYTE: &[Field] = &[TX_GAIN, TX_GAIN_UNUSED];
     /// SS_DataRequest header length (offset relative).
     pub const HEADER_LENGTH: Field = Field::uint("header_length", "Header length", 0, 1);
 }
@@ -247,14 +252,18 @@ pub mod indication_data {
     );
     /// Byte 0 bits 4-7.
     pub const PGA_VALUE: Field = Field::bits_uint("pga_value", "PGA value", 0, 4, 4);
-    /// Byte 1: signed dB; 255 means "no meaning" (FSK frames).
-    pub const SNR: Field = Field::int("snr", "SNR", 1, 1).unit("dB").absent_when(0xFF);
+    /// Byte 1: signed dB, "valid for PSK received frames only, equal to
+    /// 255 – no meaning – for FSK received frames" (Tables 39, 48): 255 is
+    /// no value after a B-FSK frame, and -1 dB after a PSK one.
+    pub const SNR: Field = Field::int("snr", "SNR", 1, 1).unit("dB").absent_when_with(
+        0xFF,
+        &FRAME_MODULATION,
+        3, // B-FSK
+    );
     /// Bytes 2-3, signed, 13 µs steps.
     pub const ZC_DELAY: Field = Field::int("zc_delay", "ZC delay", 2, 2).unit("13 µs");
     /// Bytes 0-3 of Table 39.
     pub const LAYOUT: &[Field] = &[FRAME_MODULATION, RX_CHANNEL, PGA_VALUE, SNR, ZC_DELAY];
     /// Bytes before the payload.
     pub const LEN: usize = 4;
-    /// The raw SNR byte of a frame received with FSK (Table 39).
-    pub const SNR_NO_MEANING: u8 = 0xFF;
 }

@@ -247,15 +247,46 @@ pub fn dl_open(opts: &DlOptions, psdu: &[u8]) -> Result<DlReceived, PlcError> {
         });
     }
     let (payload, crc) = body.split_at(body.len() - crc_len);
+    Ok(check_crc(opts, psdu[0], payload, crc))
+}
+
+fn check_crc(opts: &DlOptions, phy_length: u8, payload: &[u8], crc: &[u8]) -> DlReceived {
     let payload = payload.to_vec();
-    Ok(if opts.crc(psdu[0], &payload) == crc {
+    if opts.crc(phy_length, &payload) == crc {
         DlReceived::Good { payload }
     } else {
         DlReceived::WrongCrc {
             payload,
             crc: crc.to_vec(),
         }
-    })
+    }
+}
+
+/// An SS frame around an SS_SDU ([`ss_seal`]): the PHY length byte counts
+/// the SS_SDU only, then the DL CRC of MIB 00h follows, uncounted. Table 4
+/// gives the encrypted payload `LEN-29-HL` bytes, so LEN (the frame's
+/// length) holds header, payload, IV, HL and digest and no CRC; and Tables
+/// 45 and 48 allow 226 bytes of header and payload, 255 with the 29, with
+/// every CRC length. See `docs/protocol-notes.md`.
+pub fn ss_frame(opts: &DlOptions, sdu: &[u8]) -> Result<Vec<u8>, PlcError> {
+    let mut out = phy_frame(sdu)?;
+    out.extend(opts.crc(out[0], sdu));
+    Ok(out)
+}
+
+/// Opens an SS frame ([`ss_frame`]): the SS_SDU its length byte announces,
+/// then the CRC, which is checked.
+pub fn ss_frame_open(opts: &DlOptions, psdu: &[u8]) -> Result<DlReceived, PlcError> {
+    let (&len, rest) = psdu.split_first().ok_or(PlcError::Empty)?;
+    let declared = len as usize + opts.crc.len();
+    if rest.len() != declared {
+        return Err(PlcError::LengthMismatch {
+            declared,
+            got: rest.len(),
+        });
+    }
+    let (sdu, crc) = rest.split_at(len as usize);
+    Ok(check_crc(opts, len, sdu, crc))
 }
 
 /// Length of the AES-CTR initialization vector of an SS frame (Table 4).
@@ -311,8 +342,7 @@ fn counter_block(iv: &[u8; IV_LEN]) -> [u8; 16] {
 /// The SS_SDU of UM0932 Figure 4, Table 4: header (clear) | encrypted
 /// payload | IV | HL | digest. `header_and_payload` is the user data of
 /// SS_DataRequest (Table 45), its first `header_len` bytes the header.
-/// The SDU still needs a DL frame ([`dl_frame`]) around it, whose CRC must
-/// fit too (see `validate::check_request`).
+/// The SDU still needs its frame ([`ss_frame`]) around it.
 pub fn ss_seal(
     key: &[u8; 16],
     iv: &[u8; IV_LEN],
@@ -407,5 +437,34 @@ mod tests {
         ctr_apply(&key, &cb, &mut chunked);
         ctr::Ctr32BE::<Aes128>::new(&key.into(), &cb.into()).apply_keystream(&mut whole);
         assert_eq!(chunked, whole);
+    }
+
+    #[test]
+    fn an_ss_frame_of_226_bytes_fits_with_every_crc() {
+        // UM0932 Tables 45 and 48: up to 226 bytes of header and payload.
+        let key = [3u8; 16];
+        let data: Vec<u8> = (0..226u32).map(|i| i as u8).collect();
+        let sdu = ss_seal(&key, &[1; IV_LEN], 4, &data).unwrap();
+        assert_eq!(sdu.len(), MAX_LENGTH);
+        for code in 0..4 {
+            let opts = DlOptions {
+                crc: DlCrc::from_code(code),
+                crc_on_phy_length: code == 3,
+            };
+            let psdu = ss_frame(&opts, &sdu).unwrap();
+            assert_eq!(psdu[0], 255, "the length counts the SS_SDU only");
+            assert_eq!(psdu.len(), 1 + 255 + opts.crc.len());
+            let Ok(DlReceived::Good { payload }) = ss_frame_open(&opts, &psdu) else {
+                panic!("CRC code {code}");
+            };
+            assert_eq!(ss_open(&key, &payload).unwrap(), data);
+            let mut bad = psdu.clone();
+            bad[10] ^= 1;
+            assert!(matches!(
+                ss_frame_open(&opts, &bad),
+                Ok(DlReceived::WrongCrc { .. })
+            ));
+            assert!(ss_frame_open(&opts, &psdu[..psdu.len() - 1]).is_err());
+        }
     }
 }

@@ -205,7 +205,10 @@ pub struct TxParams {
     pub zero_crossing_sync: bool,
     /// Custom TX frequency in Hz (24 bits), or the MIB frequency.
     pub tx_frequency: Option<u32>,
-    /// Custom TX gain (5 bits), or the MIB gain.
+    /// The custom TX gain byte (Table 35 byte 4 or 1), or the MIB gain:
+    /// the gain in bits 0-4; bits 5-7 are unused and kept as sent, so that
+    /// validation refuses them as it refuses a MIB object's (see protocol
+    /// notes). A gain of 0-31 is the whole byte.
     pub tx_gain: Option<u8>,
 }
 
@@ -238,7 +241,7 @@ impl TxParams {
             None
         };
         let tx_gain = if gain {
-            let v = get(&tx::TX_GAIN, data.get(at..)?);
+            let v = *data.get(at)?;
             at += 1;
             Some(v)
         } else {
@@ -273,9 +276,7 @@ impl TxParams {
             out.extend_from_slice(&b);
         }
         if let Some(g) = self.tx_gain {
-            let mut b = [0u8];
-            tx::TX_GAIN.set(&mut b, g as i64);
-            out.push(b[0]);
+            out.push(g);
         }
     }
 
@@ -407,9 +408,12 @@ impl IndicationInfo {
         d
     }
 
-    /// SNR in dB, `None` for FSK frames (raw 255).
+    /// SNR in dB, `None` for a B-FSK frame's 255 (no meaning, Table 39).
     pub fn snr_db(&self) -> Option<i8> {
-        (self.snr != ind::SNR_NO_MEANING).then_some(self.snr as i8)
+        match ind::SNR.read(&self.encode()) {
+            Some(crate::field::Value::Int(v)) => Some(v as i8),
+            _ => None,
+        }
     }
 }
 

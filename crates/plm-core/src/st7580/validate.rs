@@ -4,7 +4,7 @@
 //! is sent.
 
 use super::fields::tx_options;
-use super::{mib, plc, Command, ErrorCause, Modulation, TxParams};
+use super::{mib, Command, ErrorCause, Modulation, TxParams};
 use alloc::format;
 use alloc::string::String;
 use core::fmt;
@@ -44,17 +44,53 @@ fn check_params(p: &TxParams) -> Result<(), Refusal> {
             .map_err(|e| wpv(format!("{e}")))?;
     }
     if let Some(g) = p.tx_gain {
+        // Table 35: the gain is bits 0-4 of its byte; bits 5-7, "Unused",
+        // must be 0 like every unused or reserved bit (protocol notes).
         tx_options::TX_GAIN
             .check(g as i64)
-            .map_err(|e| wpv(format!("{e}")))?;
+            .map_err(|e| wpv(format!("{e} (bits 5-7 of the TX gain byte are unused: 0)")))?;
+    }
+    Ok(())
+}
+
+/// The header-length rules of an SS_DataRequest (UM0932 Table 45, 2.3):
+/// header and payload, "from 0 to 226 byte", whatever the DL CRC (an SS
+/// frame's length byte does not count its CRC, `plc::ss_frame`); a header
+/// length within that buffer, at least 4 when a payload follows and at
+/// least 16 when the header is the whole buffer. The one rule for the
+/// simulated modem, the console's form and the decoder's warning.
+pub fn check_ss_buffer(header_length: u8, len: usize) -> Result<(), Refusal> {
+    let hl = header_length as usize;
+    if len > SS_MAX_BUFFER {
+        return Err(Refusal {
+            cause: ErrorCause::WrongParameterLength,
+            reason: format!("header and payload are {len} bytes, more than {SS_MAX_BUFFER}"),
+        });
+    }
+    // A length that does not fit the buffer is a wrong value of the
+    // header length parameter, not a wrong length of the command (Table 14).
+    if hl > len {
+        return Err(wpv(format!(
+            "header length {hl} is longer than the {len} bytes given"
+        )));
+    }
+    let min = if hl < len { 4 } else { 16 };
+    if hl < min {
+        return Err(wpv(format!(
+            "header length {hl} is below {min} ({})",
+            if min == 4 {
+                "a payload follows"
+            } else {
+                "the header is the whole buffer"
+            }
+        )));
     }
     Ok(())
 }
 
 /// Checks a request as the chip does. `dl_crc_len` is the DL CRC length in
-/// bytes from MIB 00h (1, 2 or 4): a DL frame's payload plus CRC, and an SS
-/// frame's header and payload plus 29 bytes of IV, HL and digest plus CRC,
-/// must fit the PHY length byte (UM0932 Tables 3 and 4).
+/// bytes from MIB 00h (1, 2 or 4): a DL frame's payload plus CRC must fit
+/// the PHY length byte (UM0932 Tables 2 and 3).
 pub fn check_request(cmd: &Command, dl_crc_len: usize) -> Result<(), Refusal> {
     match cmd {
         Command::MibWriteRequest { index, data } => mib::check_write(*index, data)
@@ -82,48 +118,7 @@ pub fn check_request(cmd: &Command, dl_crc_len: usize) -> Result<(), Refusal> {
         }
         Command::SsDataRequest(r) => {
             check_params(&r.params)?;
-            let total = r.header_and_payload.len();
-            let hl = r.header_length as usize;
-            let wpl = |reason| {
-                Err(Refusal {
-                    cause: ErrorCause::WrongParameterLength,
-                    reason,
-                })
-            };
-            if total > SS_MAX_BUFFER {
-                return wpl(format!(
-                    "header and payload are {total} bytes, more than {SS_MAX_BUFFER}"
-                ));
-            }
-            // The SS_SDU (Table 4) adds IV, HL and digest, and rides in a DL
-            // frame whose CRC must fit the PHY length byte too (Table 3).
-            let frame = total + plc::SS_OVERHEAD + dl_crc_len;
-            if frame > plc::MAX_LENGTH {
-                return wpl(format!(
-                    "header and payload of {total} bytes plus {} bytes of IV, HL and digest and a {dl_crc_len}-byte CRC exceed the {} bytes of a PHY frame",
-                    plc::SS_OVERHEAD,
-                    plc::MAX_LENGTH
-                ));
-            }
-            if hl > total {
-                return wpl(format!(
-                    "header length {hl} is longer than the {total} bytes given"
-                ));
-            }
-            // Table 45 (see protocol notes): at least 4 header bytes before an
-            // encrypted payload, at least 16 when there is no payload.
-            let min = if hl < total { 4 } else { 16 };
-            if hl < min {
-                return Err(wpv(format!(
-                    "header length {hl} is below {min} ({})",
-                    if min == 4 {
-                        "a payload follows"
-                    } else {
-                        "the header is the whole buffer"
-                    }
-                )));
-            }
-            Ok(())
+            check_ss_buffer(r.header_length, r.header_and_payload.len())
         }
         _ => Ok(()),
     }
@@ -153,20 +148,14 @@ mod tests {
     }
 
     #[test]
-    fn ss_requests_must_fit_a_dl_frame_with_its_crc() {
-        let wpl = |hl, len, crc| {
-            check_request(&ss(hl, len), crc).map_err(|e| e.cause)
-                == Err(ErrorCause::WrongParameterLength)
-        };
-        // 255 = header and payload + 29 (IV, HL, digest) + CRC.
-        assert!(check_request(&ss(4, 222), 4).is_ok());
-        assert!(wpl(4, 223, 4));
-        assert!(check_request(&ss(4, 224), 2).is_ok());
-        assert!(wpl(4, 225, 2));
-        assert!(check_request(&ss(4, 225), 1).is_ok());
-        assert!(wpl(4, 226, 1), "226 of Table 45 leaves no room for a CRC");
-        let e = check_request(&ss(4, 223), 4).unwrap_err();
-        assert!(e.reason.contains("4-byte CRC"), "{e}");
+    fn ss_requests_take_226_bytes_with_every_crc() {
+        // UM0932 Table 45: "from 0 to 226 byte"; Table 48: "up to 226".
+        for crc in [1, 2, 4] {
+            assert!(check_request(&ss(4, 226), crc).is_ok(), "CRC of {crc}");
+            let e = check_request(&ss(4, 227), crc).unwrap_err();
+            assert_eq!(e.cause, ErrorCause::WrongParameterLength);
+            assert!(e.reason.contains("227 bytes"), "{e}");
+        }
     }
 
     #[test]
@@ -185,9 +174,10 @@ mod tests {
             check_request(&ss(4, 227), 4).unwrap_err().cause,
             ErrorCause::WrongParameterLength
         );
+        // A header length beyond the buffer is a wrong value (WPV).
         assert_eq!(
             check_request(&ss(11, 10), 4).unwrap_err().cause,
-            ErrorCause::WrongParameterLength
+            ErrorCause::WrongParameterValue
         );
     }
 
@@ -214,6 +204,32 @@ mod tests {
                 .cause,
             ErrorCause::WrongParameterLength
         );
+    }
+
+    #[test]
+    fn unused_gain_bits_are_refused_like_a_mib_objects() {
+        // One policy for unused and reserved bits (protocol notes): Table
+        // 35's TX gain byte, bits 5-7, as Table 54's byte 7 bits 5-7.
+        let mut r = DataRequest::default();
+        r.params.tx_gain = Some(0x20 | 21);
+        let phy = Command::PhyDataRequest(r.clone());
+        let parsed = Command::parse(phy.code(), &phy.data()).unwrap();
+        assert_eq!(parsed, phy, "the unused bits are kept");
+        let e = check_request(&parsed, 4).unwrap_err();
+        assert_eq!(e.cause, ErrorCause::WrongParameterValue);
+        assert!(e.reason.contains("unused"), "{e}");
+        let mut phy_config = mib::OBJECTS[1].default.to_vec();
+        phy_config[7] |= 0x20;
+        let mib = Command::MibWriteRequest {
+            index: 1,
+            data: phy_config,
+        };
+        assert_eq!(
+            check_request(&mib, 4).unwrap_err().cause,
+            ErrorCause::WrongParameterValue
+        );
+        r.params.tx_gain = Some(21);
+        assert!(check_request(&Command::PhyDataRequest(r), 4).is_ok());
     }
 
     #[test]

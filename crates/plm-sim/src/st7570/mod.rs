@@ -497,6 +497,9 @@ impl St7570 {
                         return;
                     }
                 }
+                // 5.3.26: "the value declared in the length field has not
+                // been respected": a frame cut short by T_IC.
+                DeviceEvent::FrameCut => self.submit(now, requests::SYNTAX_ERROR),
                 // Table 11: ALARM is set in one status message only.
                 DeviceEvent::Sent(Element::Status(_)) => self.alarm_flag = false,
                 _ => {}

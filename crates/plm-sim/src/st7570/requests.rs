@@ -31,7 +31,7 @@ pub mod confirm {
 }
 
 /// 5.3.26: ERROR is 01h.
-const SYNTAX_ERROR: Command = Command::SyntaxError { error: 0x01 };
+pub(super) const SYNTAX_ERROR: Command = Command::SyntaxError { error: 0x01 };
 
 impl St7570 {
     /// The answer to a request the link engine accepted, if any.

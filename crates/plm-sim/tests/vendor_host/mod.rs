@@ -123,7 +123,7 @@ impl VendorHost {
     pub fn new(role: Role, baud: u32, now: Instant) -> VendorHost {
         let mut engine =
             HostEngine::new(Dialect::St7580, HostConfig::at_reset(Dialect::St7580, baud));
-        engine.set_not_now(NOT_NOW);
+        engine.set_not_now(NOT_NOW, 0);
         let _ = now;
         // The demo's configuration: DL layer with CRC-32, B-PSK coded at
         // 117 kHz, high channel only.

@@ -1,0 +1,132 @@
+//! When the page runs the sessions: when bytes arrive, at the engines'
+//! next deadline, and at once after the user acts; never on a fixed
+//! timer, and not at all while nothing is due (issue 13, "event-driven
+//! link").
+//!
+//! Browsers clamp a `setTimeout` set from inside another timer's callback
+//! to 4 ms once five are nested, which is the whole budget of an ACK
+//! (UM0932 3.2.8). So the wake is always asked for through a
+//! `MessageChannel` message (a task of its own, never clamped), and the
+//! timer for a later deadline is set from that message's task, where timers
+//! do not nest. Natively (the tests) there is no page: nothing is run.
+
+#[cfg(target_arch = "wasm32")]
+mod page {
+    use crate::stores::page_now_us;
+    use std::cell::RefCell;
+    use std::rc::Rc;
+    use wasm_bindgen::closure::Closure;
+    use wasm_bindgen::JsCast;
+    use web_sys::{MessageChannel, MessagePort};
+
+    struct Waker {
+        run: Rc<dyn Fn()>,
+        /// When to run next, µs of the page's clock (infinite: nothing due).
+        due: f64,
+        /// A message is on its way.
+        posted: bool,
+        timer: Option<i32>,
+        port: MessagePort,
+        on_timer: Closure<dyn FnMut()>,
+        _on_message: Closure<dyn FnMut()>,
+    }
+
+    thread_local! {
+        static WAKER: RefCell<Option<Waker>> = const { RefCell::new(None) };
+    }
+
+    pub fn install(run: Rc<dyn Fn()>) {
+        let Ok(channel) = MessageChannel::new() else {
+            return;
+        };
+        let on_message = Closure::<dyn FnMut()>::new(|| {
+            with(|w| w.posted = false);
+            arm();
+        });
+        channel
+            .port1()
+            .set_onmessage(Some(on_message.as_ref().unchecked_ref()));
+        let on_timer = Closure::<dyn FnMut()>::new(|| {
+            with(|w| w.timer = None);
+            arm();
+        });
+        WAKER.with(|w| {
+            *w.borrow_mut() = Some(Waker {
+                run,
+                due: f64::INFINITY,
+                posted: false,
+                timer: None,
+                port: channel.port2(),
+                on_timer,
+                _on_message: on_message,
+            })
+        });
+    }
+
+    fn with<R: Default>(f: impl FnOnce(&mut Waker) -> R) -> R {
+        WAKER.with(|w| w.borrow_mut().as_mut().map(f).unwrap_or_default())
+    }
+
+    /// Runs if due, else sets the one timer for the time left.
+    fn arm() {
+        let now = page_now_us();
+        let run = with(|w| {
+            if w.due <= now + 100.0 {
+                w.due = f64::INFINITY;
+                return Some(w.run.clone());
+            }
+            if w.due.is_finite() && w.timer.is_none() {
+                let ms = ((w.due - now) / 1_000.0).ceil() as i32;
+                w.timer = web_sys::window().and_then(|win| {
+                    win.set_timeout_with_callback_and_timeout_and_arguments_0(
+                        w.on_timer.as_ref().unchecked_ref(),
+                        ms,
+                    )
+                    .ok()
+                });
+            }
+            None
+        });
+        if let Some(run) = run {
+            run();
+        }
+    }
+
+    pub fn at(page_us: f64) {
+        with(|w| {
+            if page_us >= w.due {
+                return;
+            }
+            w.due = page_us;
+            if let (Some(t), Some(win)) = (w.timer.take(), web_sys::window()) {
+                win.clear_timeout_with_handle(t);
+            }
+            if !w.posted {
+                w.posted = w.port.post_message(&wasm_bindgen::JsValue::NULL).is_ok();
+            }
+        });
+    }
+}
+
+/// Makes `run` the page's work: [`soon`] and [`at`] call it.
+pub fn install(run: impl Fn() + 'static) {
+    #[cfg(target_arch = "wasm32")]
+    page::install(std::rc::Rc::new(run));
+    #[cfg(not(target_arch = "wasm32"))]
+    let _ = run;
+}
+
+/// Runs the page's work as soon as the page can (bytes came, the user
+/// acted).
+pub fn soon() {
+    at(0.0);
+}
+
+/// Runs the page's work when the page's clock reaches `page_us` (µs), or
+/// earlier if asked.
+pub fn at(page_us: f64) {
+    #[cfg(target_arch = "wasm32")]
+    page::at(page_us);
+    #[cfg(not(target_arch = "wasm32"))]
+    let _ = page_us;
+}
