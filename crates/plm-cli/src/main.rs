@@ -92,7 +92,9 @@ struct DecodeArgs {
 
 #[derive(clap::Args)]
 struct SimArgs {
-    /// Which chip to simulate (only the ST7580 so far: st7570 is refused).
+    /// Which chip to simulate: st7580 (PSK/FSK) or st7570 (S-FSK: node 0
+    /// the host's modem, the other nodes MAC Servers that answer, every
+    /// third a repeater; not with --street, --board or --peers).
     #[arg(long, value_enum, default_value = "st7580")]
     chip: Chip,
     /// Address to listen on; port 0 picks a free port (the one chosen is
@@ -104,8 +106,9 @@ struct SimArgs {
     #[arg(long)]
     allow_remote: bool,
     /// Modems on the simulated power line (1-64, default: as many as
-    /// served): the served ones and the others, which echo what they
-    /// hear. Not with --street or --board.
+    /// served; with --chip st7570 3 more): the served ones and the others,
+    /// which echo what they hear (ST7570: answer what is sent to them).
+    /// Not with --street or --board.
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=64), conflicts_with_all = ["street", "board"])]
     nodes: Option<u16>,
     /// Serve nodes 0..N-1 of the line, each on its own RFC 2217 port
@@ -200,9 +203,49 @@ fn main() -> ExitCode {
 }
 
 fn sim(args: SimArgs) -> Result<(), String> {
-    if let Chip::St7570 = args.chip {
-        return Err("the ST7570 is not simulated yet; use --chip st7580".into());
+    let world = match args.chip {
+        Chip::St7580 => st7580_world(&args)?,
+        Chip::St7570 => st7570_world(&args)?,
+    };
+    sim_server::run(sim_server::Options {
+        listen: args.listen,
+        allow_remote: args.allow_remote,
+        world,
+        seed: args.seed,
+    })
+}
+
+/// `plm sim --chip st7570`: a line of ST7570s; the options of streets and
+/// echoing ST7580 peers are refused rather than ignored.
+fn st7570_world(args: &SimArgs) -> Result<sim_server::World, String> {
+    for (given, flag) in [
+        (args.street.is_some(), "--street"),
+        (args.board, "--board"),
+        (args.peers.is_some(), "--peers"),
+        (args.cold_lamps, "--cold-lamps"),
+        (args.lamp_failures > 0.0, "--lamp-failures"),
+    ] {
+        if given {
+            return Err(format!(
+                "{flag} cannot be used with --chip st7570: the ST7570 line has no street-light \
+                 boards and its other nodes are MAC Servers that answer, not echoing ST7580s"
+            ));
+        }
     }
+    let serve = usize::from(args.serve);
+    let nodes = args
+        .nodes
+        .map_or(serve + sim_server::DEFAULT_ST7570_NODES - 1, usize::from);
+    if nodes < serve {
+        return Err(format!(
+            "--nodes {nodes} --serve {serve}: the served nodes are nodes of the line; \
+             give --nodes {serve} or more"
+        ));
+    }
+    Ok(sim_server::World::St7570 { nodes, serve })
+}
+
+fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
     let world = match (args.board, args.street) {
         (true, n) => sim_server::World::Street {
             lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),
@@ -246,12 +289,7 @@ fn sim(args: SimArgs) -> Result<(), String> {
             }
         }
     };
-    sim_server::run(sim_server::Options {
-        listen: args.listen,
-        allow_remote: args.allow_remote,
-        world,
-        seed: args.seed,
-    })
+    Ok(world)
 }
 
 fn decode(args: DecodeArgs) -> Result<(), String> {

@@ -3,7 +3,11 @@
 //! ser2net clients, the console's own TCP transport) can drive it; or,
 //! with `--board`, a street-light concentrator board's USART with a
 //! street of lamps behind it (application frames, RTS ignored: a board's
-//! USART has no T_REQ).
+//! USART has no T_REQ); or, with `--chip st7570`, an S-FSK line of
+//! ST7570s ([`plm_sim::st7570::net::Network`]) whose node 0 is the
+//! client's modem and whose other nodes are answering MAC Servers, every
+//! [`REPEATER_EVERY`]-th a repeater. One loop serves both chips: it
+//! reaches the simulation through [`plm_sim::Ports`].
 //!
 //! The loop ([`event_loop`]) maps wall-clock time since the first client
 //! connected onto the simulator's virtual microseconds, and wakes when a
@@ -42,6 +46,15 @@ use std::net::{SocketAddr, TcpListener, ToSocketAddrs};
 /// Lamps on a street unless told otherwise (`--board` alone).
 pub const DEFAULT_STREET: usize = 12;
 
+/// ST7570 nodes on the line unless told otherwise: the host's modem and
+/// three Servers, the third a repeater.
+pub const DEFAULT_ST7570_NODES: usize = 4;
+
+/// Every this many nodes along an ST7570 line, a Server is a repeater
+/// (nodes 3, 6, 9, ...): a frame then crosses at most two Servers to the
+/// next repeater, well inside a hop's reach on the default line.
+pub const REPEATER_EVERY: usize = 3;
+
 /// What is simulated behind the served port.
 pub enum World {
     /// Modems: `serve` served ones and the others echoing.
@@ -53,6 +66,16 @@ pub enum World {
         /// Who the echoing peers are ([`Peers::Echo`]: factory MIB;
         /// [`Peers::EchoFollowing`]: node 0's MIB 00h/01h).
         peers: Peers,
+    },
+    /// ST7570 modems on one S-FSK line (`--chip st7570`): nodes
+    /// 0..serve served (their host is the client), the others
+    /// [`plm_sim::st7570::responder::Responder`] MAC Servers, every
+    /// [`REPEATER_EVERY`]-th a repeater.
+    St7570 {
+        /// Modems on the line.
+        nodes: usize,
+        /// Nodes 0..serve served, each on its own port.
+        serve: usize,
     },
     /// A street of lamps behind the served modem or concentrator board.
     Street {
@@ -105,7 +128,7 @@ pub fn run(opts: Options) -> Result<(), String> {
 /// nothing runs until [`Served::run`].
 pub fn bind(opts: Options) -> Result<Bound, String> {
     let serve = match opts.world {
-        World::Modems { serve, .. } => serve.max(1),
+        World::Modems { serve, .. } | World::St7570 { serve, .. } => serve.max(1),
         World::Street { .. } => 1,
     };
     let listeners = bind_all(&opts.listen, opts.allow_remote, serve)?;
@@ -114,7 +137,17 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         .map(|l| l.local_addr().map_err(|e| e.to_string()))
         .collect::<Result<_, _>>()?;
     let addr = addrs[0];
+    if let World::St7570 { nodes, serve } = opts.world {
+        return Ok(bind_st7570(
+            addrs,
+            listeners,
+            nodes.max(serve),
+            serve,
+            opts.seed,
+        ));
+    }
     let (config, what) = match opts.world {
+        World::St7570 { .. } => unreachable!("served above"),
         World::Modems {
             nodes,
             serve,
@@ -203,8 +236,91 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
     Ok(Bound {
         addrs,
         banner,
-        served: Served::new(sim, listeners, signatures),
+        served: Served::new(Box::new(sim), listeners, signatures),
     })
+}
+
+/// `plm sim --chip st7570`: an S-FSK line of `nodes` ST7570s, nodes
+/// 0..serve served at `addrs`, the others MAC Servers that configure
+/// themselves and answer what is sent to them.
+fn bind_st7570(
+    addrs: Vec<SocketAddr>,
+    listeners: Vec<TcpListener>,
+    nodes: usize,
+    serve: usize,
+    seed: u64,
+) -> Bound {
+    use plm_sim::st7570::net::{NetConfig, Network};
+    let repeaters: Vec<usize> = (serve..nodes).filter(|i| i % REPEATER_EVERY == 0).collect();
+    let net = Network::new(NetConfig {
+        seed,
+        served: serve,
+        responders: (serve..nodes)
+            .map(|i| (i, repeaters.contains(&i)))
+            .collect(),
+        ..NetConfig::new(nodes)
+    });
+    let addr = addrs[0];
+    let what = if serve > 1 {
+        format!(
+            "simulated ST7570 S-FSK line (nodes 0-{} of {nodes} served",
+            serve - 1
+        )
+    } else {
+        format!("simulated ST7570 S-FSK line (node 0 of {nodes}")
+    };
+    let mut banner = vec![format!(
+        "plm sim: {what}, seed {seed}) as RFC 2217 on {addr} \
+         — connect with e.g. pyserial rfc2217://{addr}"
+    )];
+    if serve > 1 {
+        for (i, a) in addrs.iter().enumerate() {
+            banner.push(format!("plm sim: node {i} on rfc2217://{a}"));
+        }
+    }
+    banner.push(format!(
+        "plm sim: {} with the factory MIB (IDLE, PHY): write 00A1h to make {} a MAC Client",
+        if serve > 1 {
+            "the served modems power on"
+        } else {
+            "node 0 powers on"
+        },
+        if serve > 1 { "one" } else { "it" }
+    ));
+    if nodes > serve {
+        let list = |v: &[usize]| {
+            v.iter()
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        banner.push(format!(
+            "plm sim: nodes {serve}-{} are MAC Servers at their node number (001h, 002h, ...), \
+             answering frames sent to them: an M_SDU starting with '?' with '!ADDR phase N', \
+             anything else echoed",
+            nodes - 1
+        ));
+        banner.push(if repeaters.is_empty() {
+            "plm sim: no repeater (repeaters are nodes 3, 6, 9, ...: add --nodes 4 or more)".into()
+        } else {
+            format!(
+                "plm sim: repeaters (000Bh ALWAYS_REPEAT): node{} {}",
+                if repeaters.len() > 1 { "s" } else { "" },
+                list(&repeaters)
+            )
+        });
+    }
+    banner.push(
+        "plm sim: the simulation powers on when the first client connects; Ctrl-C stops".into(),
+    );
+    let signatures = (0..serve)
+        .map(|node| format!("plm sim: simulated ST7570, node {node}"))
+        .collect();
+    Bound {
+        addrs,
+        banner,
+        served: Served::new(Box::new(net), listeners, signatures),
+    }
 }
 
 /// Binds `n` ports: `listen`, then its port + 1, ... (port 0: `n` free

@@ -148,3 +148,26 @@ fn docs_and_help_name_the_same_options() {
         }
     }
 }
+
+#[test]
+fn street_and_echo_flags_are_refused_with_chip_st7570() {
+    for flag in [
+        &["--street", "3"][..],
+        &["--board"],
+        &["--peers", "factory"],
+        &["--cold-lamps"],
+        &["--lamp-failures", "1"],
+    ] {
+        let args = [&["--chip", "st7570"][..], flag].concat();
+        let err = refused(&args);
+        assert!(
+            err.contains(flag[0]) && err.contains("cannot be used with --chip st7570"),
+            "{args:?}: {err}"
+        );
+    }
+    let err = refused(&["--chip", "st7570", "--serve", "3", "--nodes", "2"]);
+    assert!(
+        err.contains("--nodes 2") && err.contains("--serve 3"),
+        "{err}"
+    );
+}

@@ -274,17 +274,6 @@ fn simulated_st7580_over_rfc2217() {
 }
 
 #[test]
-fn st7570_is_not_simulated_yet() {
-    let out = Command::new(env!("CARGO_BIN_EXE_plm"))
-        .args(["sim", "--chip", "st7570", "--listen", "127.0.0.1:0"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("not simulated yet"), "{err}");
-}
-
-#[test]
 fn a_remote_address_needs_allow_remote() {
     let out = Command::new(env!("CARGO_BIN_EXE_plm"))
         .args(["sim", "--listen", "0.0.0.0:0"])

@@ -21,6 +21,7 @@
 //! - [`board`]: the street-light controller board (STEVAL-IHP007V1) whose
 //!   firmware drives its modem, and a concentrator board's USART.
 //! - [`drive`]: plm-core's host engine driving node 0 in virtual time.
+//! - [`ports`]: the served nodes' UARTs, as `plm sim` reaches them.
 //! - [`street`]: plm-core's concentrator driving a street in virtual time.
 
 #![forbid(unsafe_code)]
@@ -33,6 +34,7 @@ pub mod echo;
 pub mod flash;
 pub mod line;
 pub mod modem;
+pub mod ports;
 pub mod rfu;
 pub mod rng;
 pub mod sim;
@@ -42,6 +44,7 @@ pub mod uart;
 
 pub use drive::{HostDriver, Outcome};
 pub use line::LineConfig;
+pub use ports::Ports;
 pub use sim::{Attach, Dir, Fault, LineEvent, Peers, Sim, SimConfig};
 pub use street::StreetDriver;
 pub use uart::{ByteFaults, BAUD_RATES};

@@ -1,7 +1,8 @@
-//! The loop of `plm sim`: one thread owns the simulation and wakes only
-//! when something happens, either a message from the sockets' threads
-//! (a connection accepted, bytes read, a connection closed, Ctrl-C) or
-//! the simulation's next deadline ([`Sim::next_deadline`]: a byte
+//! The loop of `plm sim`: one thread owns the simulation (any
+//! [`Ports`]: the ST7580 line, the ST7570 network) and wakes only when
+//! something happens, either a message from the sockets' threads (a
+//! connection accepted, bytes read, a connection closed, Ctrl-C) or the
+//! simulation's next deadline ([`Ports::next_deadline`]: a byte
 //! reaching a host, a modem timer, a line event), so that a modem's
 //! bytes reach its client when the simulated chip sends them (issue 13,
 //! point 8), and nothing runs while nothing happens.
@@ -12,13 +13,14 @@
 //! scheduler tick) ends within some tens of microseconds of the deadline.
 
 use crate::rfc2217::{self, Action};
-use plm_sim::{Fault, Sim};
+use plm_sim::Ports;
 use std::io::{ErrorKind, Read, Write};
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::time::{Duration, Instant};
 
-/// Baud rates the BR0/BR1 pins select (UM0932 3.1).
+/// Baud rates the BR0/BR1 pins select: UM0932 3.1 for the ST7580, the
+/// same four in the ST7570 UM's Table 9.
 pub const RATES: &[u32] = &plm_sim::BAUD_RATES;
 
 /// What wakes the loop.
@@ -49,7 +51,7 @@ impl Stopper {
 
 /// The simulation and its ports, served until stopped.
 pub struct Served {
-    sim: Sim,
+    sim: Box<dyn Ports + Send>,
     /// Each node's answer to RFC 2217 SIGNATURE.
     signatures: Vec<String>,
     wakes: Receiver<Wake>,
@@ -65,7 +67,11 @@ impl Served {
     /// Starts a thread accepting on each of `listeners` (node i on the
     /// i-th, whose RFC 2217 SIGNATURE is `signatures[i]`); nothing is
     /// served until [`Served::run`].
-    pub fn new(sim: Sim, listeners: Vec<TcpListener>, signatures: Vec<String>) -> Served {
+    pub fn new(
+        sim: Box<dyn Ports + Send>,
+        listeners: Vec<TcpListener>,
+        signatures: Vec<String>,
+    ) -> Served {
         let (sender, wakes) = channel();
         let clients = (0..listeners.len()).map(|_| None).collect();
         for (node, listener) in listeners.into_iter().enumerate() {
@@ -145,7 +151,7 @@ impl Served {
                 // The bytes arrived now: bring the modems up to now first.
                 self.advance();
                 let c = self.clients[node].as_mut().expect("node_of");
-                if let Err(e) = c.receive(&mut self.sim, node, &bytes) {
+                if let Err(e) = c.receive(self.sim.as_mut(), node, &bytes) {
                     self.drop_client(node, &e.to_string());
                 }
             }
@@ -222,7 +228,7 @@ impl Served {
         self.advance();
         // The host is gone: T_REQ and DTR are released (pulled up).
         self.sim.set_treq_of(node, false);
-        self.sim.inject_on(node, Fault::Resetn(false));
+        self.sim.set_resetn_of(node, false);
     }
 }
 
@@ -320,10 +326,10 @@ impl Client {
     /// | client (RFC 2217)                    | simulated modem `node`     |
     /// |--------------------------------------|----------------------------|
     /// | data                                 | host UART TX -> modem RX   |
-    /// | SET-BAUDRATE 9600/19200/38400/57600  | BR pins (`Sim::set_baud_of`) |
+    /// | SET-BAUDRATE 9600/19200/38400/57600  | BR pins (`Ports::set_baud_of`) |
     /// | SET-CONTROL RTS ON / OFF             | T_REQ asserted / released  |
     /// | SET-CONTROL DTR ON / OFF             | RESETN held low / released |
-    fn receive(&mut self, sim: &mut Sim, node: usize, bytes: &[u8]) -> std::io::Result<()> {
+    fn receive(&mut self, sim: &mut dyn Ports, node: usize, bytes: &[u8]) -> std::io::Result<()> {
         let mut reply = Vec::new();
         for action in self.telnet.receive(bytes, &mut reply) {
             match action {
@@ -332,7 +338,7 @@ impl Client {
                 Action::SetRts(on) => sim.set_treq_of(node, on),
                 // DTR wired to RESETN, as on many USB-UART boards: asserted
                 // holds the modem in reset, released boots it.
-                Action::SetDtr(on) => sim.inject_on(node, Fault::Resetn(on)),
+                Action::SetDtr(on) => sim.set_resetn_of(node, on),
                 Action::PurgeReceive => {
                     self.held.clear();
                     sim.host_read_of(node);

@@ -5,6 +5,7 @@
 
 use super::St7570;
 use crate::rng::Rng;
+use crate::sim::Dir;
 use crate::uart::Wire;
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
 use plm_core::link::Dialect;
@@ -42,6 +43,10 @@ pub struct ModemDriver {
     /// T_REQ levels, each taking effect once the bytes written before it
     /// have left the UART (a driver drains its FIFO before touching RTS).
     treq: VecDeque<(Instant, bool)>,
+    /// The host is outside ([`ModemDriver::serve_outside`]): the modem's
+    /// bytes wait here, with their arrival times, instead of going to
+    /// [`ModemDriver::host`].
+    outside: Option<Vec<(Instant, u8)>>,
 }
 
 impl ModemDriver {
@@ -65,6 +70,64 @@ impl ModemDriver {
             at_modem: VecDeque::new(),
             at_host: VecDeque::new(),
             treq: VecDeque::new(),
+            outside: None,
+        }
+    }
+
+    /// From now on the host is outside (`plm sim`'s client, the console):
+    /// it writes bytes and T_REQ levels ([`ModemDriver::write`],
+    /// [`ModemDriver::set_treq`]) and reads the modem's bytes
+    /// ([`ModemDriver::host_read`]); [`ModemDriver::host`] stays idle.
+    pub fn serve_outside(&mut self) {
+        self.outside.get_or_insert_with(Vec::new);
+    }
+
+    /// Whether the host is outside.
+    pub fn is_outside(&self) -> bool {
+        self.outside.is_some()
+    }
+
+    /// The outside host writes `bytes` on the UART now.
+    pub fn write(&mut self, bytes: &[u8]) {
+        let arrivals = self.to_modem.write(self.now, bytes, &mut self.rng);
+        self.at_modem.extend(arrivals);
+    }
+
+    /// The outside host sets T_REQ (`asserted`: low), once the bytes it
+    /// wrote before have left the UART.
+    pub fn set_treq(&mut self, asserted: bool) {
+        let at = self.to_modem.drained_at(self.now);
+        self.treq.push_back((at, asserted));
+    }
+
+    /// The modem's bytes that reached the outside host by now.
+    pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
+        self.outside
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
+    /// The UART baud rate (both ways; the modem's BR0/BR1 strapped to it).
+    pub fn baud(&self) -> u32 {
+        self.to_modem.baud()
+    }
+
+    /// Sets the UART baud rate both ways and at the modem (Table 9: its
+    /// BR0/BR1 pins strapped to match the host), for bytes written from
+    /// now on.
+    pub fn set_baud(&mut self, baud: u32) {
+        self.to_modem.set_baud(baud);
+        self.to_host.set_baud(baud);
+        self.modem.set_baud(baud);
+    }
+
+    /// One direction of the UART, for fault injection ([`Wire::faults`],
+    /// [`Wire::inject`]).
+    pub fn wire(&mut self, dir: Dir) -> &mut Wire {
+        match dir {
+            Dir::HostToModem => &mut self.to_modem,
+            Dir::ModemToHost => &mut self.to_host,
         }
     }
 
@@ -182,7 +245,10 @@ impl ModemDriver {
         }
         while let Some(&(at, b)) = self.at_host.front().filter(|(at, _)| *at <= now) {
             self.at_host.pop_front();
-            self.host.handle_rx(at, &[b]);
+            match self.outside.as_mut() {
+                Some(out) => out.push((at, b)),
+                None => self.host.handle_rx(at, &[b]),
+            }
         }
         if self.modem.poll_timeout().is_some_and(|t| t <= now) {
             self.modem.handle_timeout(now);

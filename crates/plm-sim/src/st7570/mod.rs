@@ -69,6 +69,9 @@ enum Power {
         until: Instant,
         software: bool,
     },
+    /// RESETn held low (a host that wires DTR to it): deaf, mute, no
+    /// timers, until released.
+    Held,
 }
 
 /// A request being served on the line: its confirm, when it is due, and
@@ -294,6 +297,24 @@ impl St7570 {
         self.restart(now, true, false);
     }
 
+    /// RESETn held low (`true`: the chip stops, deaf and mute, its UART
+    /// silent) or released (`false`: it boots as after any hardware
+    /// reset, [`St7570::hardware_reset`]: auto-reconfiguration, status
+    /// RESET = 0). A host wiring DTR to RESETn pulses it to reset the
+    /// modem (`plm sim`, docs/protocol-notes.md "ST7570: simulated
+    /// modem").
+    pub fn set_resetn(&mut self, now: Instant, low: bool) {
+        match (low, self.power) {
+            (true, _) => {
+                self.power = Power::Held;
+                self.jobs.clear();
+                self.line_out.clear();
+            }
+            (false, Power::Held) => self.hardware_reset(now),
+            (false, _) => {}
+        }
+    }
+
     fn restart(&mut self, now: Instant, keep: bool, power_on: bool) {
         self.mib = self.mib.after_reset(keep);
         self.software_reset = false;
@@ -361,6 +382,7 @@ impl St7570 {
     pub fn poll_timeout(&self) -> Option<Instant> {
         match self.power {
             Power::Booting { until, .. } => Some(until),
+            Power::Held => None,
             Power::On => {
                 let jobs = self.jobs.iter().map(|j| {
                     if j.confirm.is_some() {
@@ -382,11 +404,15 @@ impl St7570 {
 
     /// Runs whatever is due at `now`.
     pub fn handle_timeout(&mut self, now: Instant) {
-        if let Power::Booting { until, software } = self.power {
-            if now >= until {
-                self.boot_done(now, software);
+        match self.power {
+            Power::Booting { until, software } => {
+                if now >= until {
+                    self.boot_done(now, software);
+                }
+                return;
             }
-            return;
+            Power::Held => return,
+            Power::On => {}
         }
         self.run_jobs(now);
         self.spy_tick(now);
@@ -420,6 +446,10 @@ impl St7570 {
 
     /// The next UART output for the host.
     pub fn poll_transmit(&mut self) -> Option<Vec<u8>> {
+        // Held in reset, the chip's TXD is silent.
+        if self.power == Power::Held {
+            return None;
+        }
         // The device side only writes bytes; T_REQ is the host's line.
         loop {
             if let Transmit::Bytes(b) = self.engine.poll_transmit()? {

@@ -15,6 +15,7 @@ use super::line::{self, SfskLine, Signal};
 use super::responder::Responder;
 use super::slots::{SlotUse, Transmission, FRAME_BITS};
 use super::St7570;
+use crate::ports::Ports;
 use crate::rng::Rng;
 use plm_core::link::host::{Event, LinkError};
 use plm_core::st7570::{code, Command, Layer};
@@ -68,6 +69,11 @@ pub struct NetConfig {
     pub responders: Vec<(usize, bool)>,
     /// MAC timeouts (0002h-0004h, 0009h) run this many times faster.
     pub timeout_scale: u64,
+    /// Nodes 0..served have their host outside at byte level
+    /// ([`ModemDriver::serve_outside`]: `plm sim`'s clients, through
+    /// [`Ports`]); the others' hosts are a [`Responder`] or plm-core's
+    /// host engine driven by a test.
+    pub served: usize,
 }
 
 impl NetConfig {
@@ -80,6 +86,7 @@ impl NetConfig {
             line: SfskLine::default(),
             responders: Vec::new(),
             timeout_scale: 1,
+            served: 0,
         }
     }
 }
@@ -107,6 +114,9 @@ impl Network {
             .map(|i| {
                 let mut driver = ModemDriver::with_seed(config.baud, rng.next_u64());
                 driver.modem.set_timeout_scale(config.timeout_scale);
+                if i < config.served {
+                    driver.serve_outside();
+                }
                 let responder = config
                     .responders
                     .iter()
@@ -223,13 +233,7 @@ impl Network {
                     }
                 }
             }
-            let next = self
-                .nodes
-                .iter()
-                .map(|n| n.driver.next_due())
-                .chain(self.due.iter().map(|d| Some(due_at(d))))
-                .fold(None, earliest);
-            match next {
+            match self.next_due() {
                 Some(t) if t <= end => self.now = self.now.max(t),
                 _ => {
                     self.now = end;
@@ -244,6 +248,25 @@ impl Network {
             }
             self.run_line(now);
         }
+    }
+
+    /// The next moment a node, a wire or the line has something to do.
+    fn next_due(&self) -> Option<Instant> {
+        self.nodes
+            .iter()
+            .map(|n| n.driver.next_due())
+            .chain(self.due.iter().map(|d| Some(due_at(d))))
+            .fold(None, earliest)
+    }
+
+    /// Node `i`'s RESETn held low (`true`) or released: as a host wiring
+    /// DTR to it ([`St7570::set_resetn`]).
+    pub fn set_resetn(&mut self, i: usize, low: bool) {
+        let now = self.now;
+        let d = &mut self.nodes[i].driver;
+        d.flush(now);
+        d.modem.set_resetn(now, low);
+        d.flush(now);
     }
 
     /// After node `i` acted: its responder, its mains, its transmissions.
@@ -420,5 +443,65 @@ fn due_at(d: &Due) -> Instant {
         // The window's pattern is known at its end; a hair before the
         // boundary, so that it belongs to the slot it ends.
         Due::Window { start, slot } => start + slot - 1,
+    }
+}
+
+/// `plm sim --chip st7570`: nodes 0..[`NetConfig::served`] reached from
+/// outside at byte level.
+impl Ports for Network {
+    fn served(&self) -> usize {
+        self.nodes
+            .iter()
+            .take_while(|n| n.driver.is_outside())
+            .count()
+    }
+
+    fn write_to(&mut self, node: usize, bytes: &[u8]) {
+        let now = self.now;
+        if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
+            n.driver.flush(now);
+            n.driver.write(bytes);
+        }
+    }
+
+    fn set_treq_of(&mut self, node: usize, asserted: bool) {
+        let now = self.now;
+        if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
+            n.driver.flush(now);
+            n.driver.set_treq(asserted);
+        }
+    }
+
+    fn set_resetn_of(&mut self, node: usize, low: bool) {
+        if node < Ports::served(self) {
+            self.set_resetn(node, low);
+        }
+    }
+
+    fn baud_of(&self, node: usize) -> u32 {
+        self.nodes[node].driver.baud()
+    }
+
+    fn set_baud_of(&mut self, node: usize, baud: u32) {
+        if node < Ports::served(self) {
+            let now = self.now;
+            let d = &mut self.nodes[node].driver;
+            d.flush(now);
+            d.set_baud(baud);
+        }
+    }
+
+    fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
+        self.nodes
+            .get_mut(node)
+            .map_or_else(Vec::new, |n| n.driver.host_read())
+    }
+
+    fn next_deadline(&self) -> Option<Instant> {
+        self.next_due()
+    }
+
+    fn advance_to(&mut self, t: Instant) {
+        self.run_for(t.saturating_sub(self.now));
     }
 }
