@@ -199,8 +199,8 @@ pub struct Spread {
 }
 
 impl Spread {
-    fn of(mut samples: Vec<Duration>) -> Spread {
-        samples.sort_unstable();
+    /// The spread of `samples`, in order.
+    fn of(samples: &[Duration]) -> Spread {
         // Nearest rank: the smallest value with at least p of the samples
         // at or below it.
         let rank = |p: usize| samples[(samples.len() * p).div_ceil(100).max(1) - 1];
@@ -232,29 +232,53 @@ pub struct AckLatency {
     pub page: Spread,
 }
 
-/// The raw ACK latencies, bounded.
+/// The raw ACK latencies, bounded, and the same kept in order (a sample
+/// goes in and out by binary search: no sort, whose code would cost the
+/// page 1.5 KiB for this one list).
 #[derive(Debug, Default)]
 struct AckTimes {
     count: u64,
     /// (transport's clock, page's clock), oldest first.
     samples: VecDeque<(Duration, Duration)>,
+    /// The transport's clock's and the page's, each in order.
+    link: Vec<Duration>,
+    page: Vec<Duration>,
 }
 
 impl AckTimes {
     fn record(&mut self, link: Duration, page: Duration) {
         if self.samples.len() == ACK_SAMPLES {
-            self.samples.pop_front();
+            if let Some((l, p)) = self.samples.pop_front() {
+                take_out(&mut self.link, l);
+                take_out(&mut self.page, p);
+            }
         }
         self.samples.push_back((link, page));
+        put_in(&mut self.link, link);
+        put_in(&mut self.page, page);
         self.count += 1;
     }
 
     fn stats(&self) -> AckLatency {
         AckLatency {
             count: self.count,
-            link: Spread::of(self.samples.iter().map(|s| s.0).collect()),
-            page: Spread::of(self.samples.iter().map(|s| s.1).collect()),
+            link: Spread::of(&self.link),
+            page: Spread::of(&self.page),
         }
+    }
+}
+
+/// Puts `x` into the ordered `v`.
+fn put_in(v: &mut Vec<Duration>, x: Duration) {
+    let i = v.partition_point(|&y| y <= x);
+    v.insert(i, x);
+}
+
+/// Takes one `x` out of the ordered `v`.
+fn take_out(v: &mut Vec<Duration>, x: Duration) {
+    let i = v.partition_point(|&y| y < x);
+    if v.get(i) == Some(&x) {
+        v.remove(i);
     }
 }
 
@@ -1045,10 +1069,14 @@ mod tests {
 
     #[test]
     fn ack_latency_percentiles_cover_the_most_recent_samples() {
-        assert_eq!(Spread::of(vec![]), Spread::default());
-        let one = Spread::of(vec![7]);
+        assert_eq!(Spread::of(&[]), Spread::default());
+        let one = Spread::of(&[7]);
         assert_eq!((one.p50, one.p99, one.max), (7, 7, 7));
-        let hundred = Spread::of((1..=100).rev().collect());
+        let mut backwards = AckTimes::default();
+        for i in (1..=100).rev() {
+            backwards.record(i, i);
+        }
+        let hundred = backwards.stats().link;
         assert_eq!((hundred.p50, hundred.p99, hundred.max), (50, 99, 100));
         let mut t = AckTimes::default();
         for i in 0..ACK_SAMPLES as u64 + 500 {

@@ -100,6 +100,14 @@ pub fn summary(d: &Decoded) -> String {
     if let Some(w) = &d.warning {
         parts.push(format!("warning: {w}"));
     }
+    // UM0932 3.2.7: the modem repeats a frame (STX 03h) it got no ACK for
+    // within T_ACK; a host's ACK that comes after the repeat began was late.
+    if d.repeat == Some(true) {
+        parts.push("repeat (STX 03h): no ACK came within T_ACK".into());
+    }
+    if d.after_t_ack == Some(true) {
+        parts.push("ACK after T_ACK: the modem had begun its repeat".into());
+    }
     parts.join("  ")
 }
 
@@ -302,6 +310,21 @@ mod tests {
             summary(d).contains("warning: BIO_ResetConfirm data is always 00h"),
             "{}",
             summary(d)
+        );
+    }
+
+    #[test]
+    fn the_summary_names_a_repeat_and_a_late_ack() {
+        // BIO_ResetConfirm sent again with STX 03h (UM0932 3.2.7).
+        let d = &elements(Source::Modem, "03 01 3d 00 3e 00")[0];
+        assert!(summary(d).contains("repeat (STX 03h)"), "{}", summary(d));
+        let mut ack = elements(Source::Host, "06").remove(0);
+        assert!(!summary(&ack).contains("after T_ACK"));
+        ack.after_t_ack = Some(true);
+        assert!(
+            summary(&ack).contains("ACK after T_ACK"),
+            "{}",
+            summary(&ack)
         );
     }
 

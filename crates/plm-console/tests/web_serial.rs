@@ -270,6 +270,7 @@ async fn open(adapter: &Adapter, settings: Settings) -> (WebSerialTransport, Los
 const DEFAULT: Settings = Settings {
     baud: 57_600,
     polarity: TReqPolarity::RtsAssertedIsLow,
+    rts_twice: false,
 };
 
 /// Index of the first element of `wire` after `from` that `f` picks.
