@@ -174,7 +174,7 @@ async function main() {
       `PLM Console, Chromium ${browser.version()}, simulated ST7580 at ${BAUD} baud`,
       '',
       `ACK latency, last byte of a modem frame to the host's ACK (${ack.count} frames; T_ACK ${ack.tAck} ms):`,
-      `  page's clock   ${spread(ack.page)}   (includes the page's timer period and stalls)`,
+      `  page's clock   ${spread(ack.page)}   (includes how late the page woke, and stalls)`,
       `  virtual link   ${spread(ack.link)}   (what the simulated modem saw: its time waits for the page)`,
       '',
       `MIB reads (MIB_ReadRequest ${MIB_INDEX.toString(16).padStart(2, '0').toUpperCase()}h, ${queued.dataLen}-byte value), ${READS} each:`,

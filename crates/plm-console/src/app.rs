@@ -1,5 +1,5 @@
-//! The root component: the stores, the page's timer that drives the
-//! session, the connection bar and the views.
+//! The root component: the stores, the wake that runs the sessions
+//! ([`crate::wake`]), the connection bar and the views.
 
 use crate::profile::Profile;
 use crate::stores::{provide_console, use_console};

@@ -223,11 +223,11 @@ pub struct AckLatency {
     /// Frames ACKed since connecting.
     pub count: u64,
     /// On the transport's clock: what the modem saw. The session steps
-    /// the transport's time in slices of [`SLICE`], so this stays within
-    /// a slice; the simulated modem's virtual time waits for the page.
+    /// the transport's time to each byte's arrival, and the simulated
+    /// modem's virtual time waits for the page, so this is 0 there.
     pub link: Spread,
     /// On the page's clock: how long after the byte arrived the page got
-    /// round to writing the ACK. It includes the page's timer period and
+    /// round to writing the ACK. It includes how late the page woke and
     /// any stall, which a real modem would see as they are.
     pub page: Spread,
 }

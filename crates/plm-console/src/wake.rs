@@ -4,8 +4,8 @@
 //! link").
 //!
 //! Browsers clamp a `setTimeout` set from inside another timer's callback
-//! to 4 ms once five are nested, which is the whole budget of an ACK
-//! (UM0932 3.2.8). So the wake is always asked for through a message the
+//! to 4 ms once five are nested, which would make every ACK (UM0932
+//! 3.2.8) and every chained request up to 4 ms late. So the wake is always asked for through a message the
 //! page posts to itself (`postMessage`: a task of its own, never clamped),
 //! and the timer for a later deadline is set from that message's task,
 //! where timers do not nest. Any message to the page looks whether

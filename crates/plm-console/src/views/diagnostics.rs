@@ -168,7 +168,7 @@ fn AckLatencyCard() -> impl IntoView {
         <article class="card" id="ack-latency">
             <h3>"ACK latency"</h3>
             <p class="muted">
-                "From the last byte of each modem frame to the host's ACK (UM0932 3.2.8), on the page's clock: it includes the page's timer period (about 4 ms) and any stall of the page."
+                "From the last byte of each modem frame to the host's ACK (UM0932 3.2.8), on the page's clock: it includes how late the page woke and any stall of the page."
             </p>
             {move || {
                 let l = latency.get();
