@@ -11,6 +11,7 @@ use plm_core::decode::Decoded;
 use plm_core::json::{self, Json};
 use plm_core::time::Instant;
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 /// Elements kept before the oldest are dropped.
 pub const CAPACITY: usize = 5_000;
@@ -114,7 +115,8 @@ pub fn summary(d: &Decoded) -> String {
 /// The bounded log.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrafficLog {
-    entries: VecDeque<Entry>,
+    /// Shared with the rows on screen, so that showing them copies nothing.
+    entries: VecDeque<Arc<Entry>>,
     capacity: usize,
     next_seq: u64,
     dropped: u64,
@@ -144,12 +146,12 @@ impl TrafficLog {
             self.dropped += 1;
         }
         let summary = summary(&decoded);
-        self.entries.push_back(Entry {
+        self.entries.push_back(Arc::new(Entry {
             seq: self.next_seq,
             at,
             decoded,
             summary,
-        });
+        }));
         self.next_seq += 1;
     }
 
@@ -180,12 +182,12 @@ impl TrafficLog {
     }
 
     /// The elements, oldest first.
-    pub fn iter(&self) -> impl DoubleEndedIterator<Item = &Entry> {
+    pub fn iter(&self) -> impl DoubleEndedIterator<Item = &Arc<Entry>> {
         self.entries.iter()
     }
 
     /// The element with this sequence number.
-    pub fn get(&self, seq: u64) -> Option<&Entry> {
+    pub fn get(&self, seq: u64) -> Option<&Arc<Entry>> {
         let first = self.entries.front()?.seq;
         self.entries.get(seq.checked_sub(first)? as usize)
     }

@@ -58,7 +58,7 @@ fn payload(e: &Entry) -> String {
 /// The SNR of each indication, in log order. Left out: B-FSK frames (SNR
 /// byte 255, "no meaning", decoded as null: UM0932 Table 39) and entries
 /// imported without a time.
-fn snr_points(rows: &[Entry]) -> Vec<Point> {
+fn snr_points(rows: &[std::sync::Arc<Entry>]) -> Vec<Point> {
     rows.iter()
         .filter_map(|e| Point::new(e.at?, field(e, "snr").parse().ok()?, &e.title()))
         .collect()
@@ -479,7 +479,7 @@ mod tests {
         for d in indication(Modulation::BPsk, 7) {
             log.push(None, d);
         }
-        let rows: Vec<Entry> = log.iter().cloned().collect();
+        let rows: Vec<_> = log.iter().cloned().collect();
         let points = snr_points(&rows);
         assert_eq!(points.len(), 1, "{points:?}");
         assert_eq!(points[0].at, 2_500_000);

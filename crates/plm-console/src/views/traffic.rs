@@ -7,6 +7,7 @@ use crate::stores::use_console;
 use crate::traffic::{Entry, Filter, CAPACITY};
 use leptos::prelude::*;
 use plm_core::st7580::code;
+use std::sync::Arc;
 
 /// Rows rendered at most; the log keeps [`CAPACITY`].
 pub const MAX_ROWS: usize = 500;
@@ -18,23 +19,37 @@ pub fn TrafficView() -> impl IntoView {
     let filter = RwSignal::new(Filter::default());
     let selected = RwSignal::new(None::<u64>);
     let message = RwSignal::new(None::<String>);
-    let rows = Memo::new(move |_| {
-        let f = filter.get();
-        let paused = c.traffic.paused_at.get();
-        c.traffic.log.with(|log| {
-            let matching: Vec<&Entry> = log
-                .iter()
-                .filter(|e| paused.is_none_or(|p| e.seq <= p))
-                .filter(|e| f.matches(e))
-                .collect();
-            let total = matching.len();
-            let shown: Vec<Entry> = matching[total.saturating_sub(MAX_ROWS)..]
-                .iter()
-                .map(|e| (*e).clone())
-                .collect();
-            (total, shown)
-        })
-    });
+    // Rows compared by what they are (their sequence numbers), not field
+    // by field: the log only ever appends, drops or clears.
+    let rows = Memo::new_with_compare(
+        move |_| {
+            let f = filter.get();
+            let paused = c.traffic.paused_at.get();
+            c.traffic.log.with(|log| {
+                let matching: Vec<&Arc<Entry>> = log
+                    .iter()
+                    .filter(|e| paused.is_none_or(|p| e.seq <= p))
+                    .filter(|e| f.matches(e))
+                    .collect();
+                let total = matching.len();
+                let shown: Vec<Arc<Entry>> = matching[total.saturating_sub(MAX_ROWS)..]
+                    .iter()
+                    .map(|e| Arc::clone(e))
+                    .collect();
+                (total, shown)
+            })
+        },
+        |old: Option<&(usize, Vec<Arc<Entry>>)>, new: Option<&(usize, Vec<Arc<Entry>>)>| match (
+            old, new,
+        ) {
+            (Some(a), Some(b)) => {
+                a.0 != b.0
+                    || a.1.len() != b.1.len()
+                    || a.1.iter().zip(&b.1).any(|(x, y)| !Arc::ptr_eq(x, y))
+            }
+            _ => true,
+        },
+    );
 
     view! {
         <div class="toolbar" id="traffic-toolbar">
@@ -231,7 +246,7 @@ fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
 }
 
 #[component]
-fn Row(entry: Entry, selected: RwSignal<Option<u64>>) -> impl IntoView {
+fn Row(entry: Arc<Entry>, selected: RwSignal<Option<u64>>) -> impl IntoView {
     let seq = entry.seq;
     let from = entry.from().to_string();
     let way = match from.as_str() {
