@@ -13,7 +13,7 @@ const PROGRESS: &str = "plm-console.update.progress";
 const HEADER_HEX: usize = 2 * 21;
 
 /// Saves `s`'s campaign as it is now (called when it changed).
-pub fn save(s: &mut StreetSession) {
+pub fn save(s: &StreetSession) {
     let Some(c) = s.campaign() else {
         return;
     };

@@ -147,7 +147,12 @@ impl StreetStore {
 
     /// Reads the fleet.
     pub fn with_fleet<R>(&self, f: impl FnOnce(&BTreeMap<plm_core::app::Address, Lamp>) -> R) -> R {
-        f(self.session().borrow().fleet())
+        self.read(|s| f(s.fleet()))
+    }
+
+    /// Reads the street session (no tick is asked for).
+    pub fn read<R>(&self, f: impl FnOnce(&StreetSession) -> R) -> R {
+        f(&self.session().borrow())
     }
 
     /// Acts on the street session; the console shows what changed at
@@ -597,7 +602,7 @@ impl Console {
             street.sent.update(|n| *n += sent);
         }
         if campaign {
-            self.street.act(crate::campaign_store::save);
+            self.street.read(crate::campaign_store::save);
             street.campaign.update(|v| *v += 1);
         }
         if !traffic.is_empty() {

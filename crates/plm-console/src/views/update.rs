@@ -77,7 +77,7 @@ pub fn UpdateView() -> impl IntoView {
     let make_size = RwSignal::new(String::from("24576"));
     let running = move || {
         street.campaign.track();
-        street.act(|s| s.campaign().map(|c| !c.update.is_done()))
+        street.read(|s| s.campaign().map(|c| !c.update.is_done()))
     };
 
     let on_file = move |ev: leptos::ev::Event| {
@@ -272,7 +272,7 @@ fn duration(us: u64) -> String {
 
 fn snapshot(street: StreetStore) -> Option<Snapshot> {
     street.campaign.track();
-    street.act(|s| {
+    street.read(|s| {
         let now = s.now();
         let c = s.campaign()?;
         let u = &c.update;
