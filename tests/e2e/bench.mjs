@@ -151,8 +151,13 @@ async function main() {
     const queued = checked(await reads(READS, false), 'queued reads');
     const chained = checked(await reads(READS, true), 'chained reads');
     const ack = await page.evaluate(() => window.plmBench.ackLatency());
-    const parts = await exchange(page);
     await page.screenshot({ path: path.join(artifacts, 'bench-diagnostics.png') });
+    // The exchange as the Traffic tab shows it (a hidden table is left as it was).
+    await page.click('#tab-traffic');
+    await page.waitForFunction(() =>
+      [...document.querySelectorAll('#traffic-table td.title')].some((td) => td.textContent === 'MIB_ReadConfirm'),
+    );
+    const parts = await exchange(page);
     if (errors.length) throw new Error(`errors in the page: ${errors.join('; ')}`);
     const street = await streetFrames(browser, base);
 

@@ -164,13 +164,13 @@ pub fn App() -> impl IntoView {
                     <UpdateView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Traffic>
-                    <TrafficView/>
+                    <TrafficView tab=tab/>
                 </Panel>
                 <Panel tab=tab which=Tab::Modem>
                     <ModemView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Data>
-                    <DataView/>
+                    <DataView tab=tab/>
                 </Panel>
                 <Panel tab=tab which=Tab::Diagnostics>
                     <DiagnosticsView/>

@@ -5,6 +5,7 @@
 
 use super::snr_plot::{self, Point};
 use super::{millis, seconds, spaced};
+use crate::app::Tab;
 use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;
@@ -64,13 +65,13 @@ fn snr_points(rows: &[std::sync::Arc<Entry>]) -> Vec<Point> {
         .collect()
 }
 
-/// The view.
+/// The view, on the page's `tab`.
 #[component]
-pub fn DataView() -> impl IntoView {
+pub fn DataView(tab: RwSignal<Tab>) -> impl IntoView {
     view! {
         <div class="cards">
             <DataRequestCard/>
-            <Indications/>
+            <Indications tab=tab/>
         </div>
     }
 }
@@ -332,9 +333,15 @@ fn DataRequestCard() -> impl IntoView {
 }
 
 #[component]
-fn Indications() -> impl IntoView {
+fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
     let c = use_console();
-    let rows = Memo::new(move |_| {
+    // Hidden, the plot keeps its points and does not look at the log (as
+    // the Traffic table).
+    let shown = move || tab.get() == Tab::Data;
+    let rows = Memo::new(move |prev: Option<&Vec<std::sync::Arc<Entry>>>| {
+        if let Some(p) = prev.filter(|_| !shown()) {
+            return p.clone();
+        }
         let mut rows = c.traffic.log.with(|l| {
             l.iter()
                 .filter(|e| {

@@ -3,6 +3,7 @@
 
 use super::files;
 use super::{seconds, spaced};
+use crate::app::Tab;
 use crate::stores::use_console;
 use crate::traffic::{Entry, Filter, CAPACITY};
 use leptos::prelude::*;
@@ -12,17 +13,24 @@ use std::sync::Arc;
 /// Rows rendered at most; the log keeps [`CAPACITY`].
 pub const MAX_ROWS: usize = 500;
 
-/// The inspector.
+/// The inspector, on the page's `tab`.
 #[component]
-pub fn TrafficView() -> impl IntoView {
+pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
     let c = use_console();
     let filter = RwSignal::new(Filter::default());
     let selected = RwSignal::new(None::<u64>);
     let message = RwSignal::new(None::<String>);
+    // Hidden, the table keeps its rows and does not even look at the log:
+    // redrawing it would only hold up the host's next ACK (issue 13), and
+    // its tab brings it up to date.
+    let shown = move || tab.get() == Tab::Traffic;
     // Rows compared by what they are (their sequence numbers), not field
     // by field: the log only ever appends, drops or clears.
     let rows = Memo::new_with_compare(
-        move |_| {
+        move |prev: Option<&(usize, Vec<Arc<Entry>>)>| {
+            if let Some(p) = prev.filter(|_| !shown()) {
+                return p.clone();
+            }
             let f = filter.get();
             let paused = c.traffic.paused_at.get();
             c.traffic.log.with(|log| {
@@ -70,10 +78,13 @@ pub fn TrafficView() -> impl IntoView {
         </div>
         <p class="counts" id="traffic-counts">
             {move || {
+                if shown() {
+                    c.traffic.log.track();
+                }
                 let (total, shown) = rows.with(|(t, s)| (*t, s.len()));
                 c.traffic
                     .log
-                    .with(|l| {
+                    .with_untracked(|l| {
                         let mut s = format!("{} elements kept (of {CAPACITY})", l.len());
                         if l.dropped() > 0 {
                             s.push_str(&format!(", {} oldest dropped", l.dropped()));
