@@ -390,18 +390,20 @@ test('WebSerial: with RESETN wired to DTR (kept per port), Reset modem pulses DT
   await page.waitForFunction(() => window.__plmSerialShim.log.some((e) => e.dtr === false));
   await page.click('#reset-resetn');
   await page.locator('#reset-result', { hasText: 'RESETN pulsed' }).waitFor();
-  // The reset cause the modem gives: RESETN or power-on (UM0932 Table 19).
-  await page.locator('#reset-cause', { hasText: 'RESETN' }).waitFor({ timeout: 10_000 });
-  const dtr = wireLog(wire).filter((e) => 'dtr' in e);
-  assert.deepEqual(dtr.map((e) => e.dtr), [false, true, false], 'released, then asserted and released');
-  assert.ok(dtr[2].at - dtr[1].at >= 10, `RESETN held low ${dtr[2].at - dtr[1].at} ms`);
-  await shot(page, 'webserial-resetn');
   await tab(page, 'traffic');
   await page.waitForFunction(
     (n) => [...document.querySelectorAll('#traffic-table tbody tr')].filter((tr) => tr.textContent.includes('BIO_ResetIndication')).length > n,
     before,
     { timeout: 10_000 },
   );
+  const dtr = wireLog(wire).filter((e) => 'dtr' in e);
+  assert.deepEqual(dtr.map((e) => e.dtr), [false, true, false], 'released, then asserted and released');
+  assert.ok(dtr[2].at - dtr[1].at >= 10, `RESETN held low ${dtr[2].at - dtr[1].at} ms`);
+  await tab(page, 'diagnostics');
+  // The reset cause the modem gives: RESETN or power-on (UM0932 Table 19).
+  await page.locator('#reset-cause', { hasText: 'RESETN' }).waitFor();
+  await shot(page, 'webserial-resetn');
+  await tab(page, 'traffic');
   await shot(page, 'webserial-resetn-traffic');
 
   // Kept for this port, not for the simulated modem.
