@@ -120,11 +120,13 @@ pub fn ConnectionBar() -> impl IntoView {
             <span class="item muted" title="Host-interface timeouts (ST7580 MIB 09h; ST7570: T_IC from 000Bh)" hidden=move || !modem()>
                 {move || {
                     let t = conn.timeouts.get();
+                    // T_IC of 5 characters is under a millisecond (ST7570).
                     format!(
-                        "T_SR {} · T_ACK {} · T_IC {} ms",
+                        "T_SR {} · T_ACK {} · T_IC {}.{} ms",
                         t.t_sr / 1000,
                         t.t_ack / 1000,
                         t.t_ic / 1000,
+                        t.t_ic % 1000 / 100,
                     )
                 }}
             </span>

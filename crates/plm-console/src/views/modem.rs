@@ -34,13 +34,15 @@ pub fn ModemView() -> impl IntoView {
         (plm_core::chip::for_dialect(dialect).mib(), dialect)
     });
     let read_all = move |_| {
-        let readable: Vec<u16> = objects
-            .get_untracked()
-            .0
-            .iter()
-            .filter(|o| o.access.read)
-            .map(|o| o.index)
-            .collect();
+        // What the modem has as configured now (an ST7570 in PHY mode
+        // has no MAC objects).
+        let readable: Vec<u16> = c.with_chip(|ch| {
+            ch.mib()
+                .iter()
+                .filter(|o| o.access.read && ch.has(o))
+                .map(|o| o.index)
+                .collect()
+        });
         let total = readable.len();
         let done = RwSignal::new(0usize);
         let failed = RwSignal::new(0usize);
@@ -310,7 +312,9 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                 <span class="muted">{object.section}</span>
             </header>
             <div class="actions">
-                <button data-action="read" on:click=move |_| read()>"Read"</button>
+                {object.access.read.then(|| view! {
+                    <button data-action="read" on:click=move |_| read()>"Read"</button>
+                })}
                 {writable
                     .then(|| {
                         view! {

@@ -32,6 +32,12 @@ pub trait Chip {
     fn dialect(&self) -> Dialect;
     /// Its MIB objects (the declarative MIB).
     fn mib(&self) -> &'static [Object];
+    /// Whether the modem has `object` as it is configured now (the ST7570
+    /// knows some objects only in one access layer, 6.5).
+    fn has(&self, object: &Object) -> bool {
+        let _ = object;
+        true
+    }
     /// The request that reads MIB object `index`.
     fn mib_read(&self, index: u16) -> LocalFrame;
     /// The request that writes `data` to MIB object `index`.

@@ -57,6 +57,10 @@ impl Chip for St7570 {
         crate::st7570::mib::OBJECTS
     }
 
+    fn has(&self, object: &Object) -> bool {
+        crate::st7570::mib::in_layer(object, self.layer())
+    }
+
     fn mib_read(&self, index: u16) -> LocalFrame {
         Command::ReadDbRequest { index }.to_frame()
     }
