@@ -302,6 +302,7 @@ mod wasm {
                         </option>
                     }
                 })
+                .map(IntoAny::into_any)
                 .collect_view()
                 .into_any()
         };
@@ -314,6 +315,7 @@ mod wasm {
                     </option>
                 }
             })
+            .map(IntoAny::into_any)
             .collect_view();
         let polarities = TReqPolarity::ALL
             .into_iter()
@@ -324,6 +326,7 @@ mod wasm {
                     </option>
                 }
             })
+            .map(IntoAny::into_any)
             .collect_view();
         let controls = if supported {
             view! {
@@ -430,7 +433,7 @@ mod wasm {
                             >
                                 {move || if active() { "Reconnect" } else { "Connect over WebSerial" }}
                             </button>
-                        })}
+                        }).map(IntoAny::into_any)}
                         <button
                             id="serial-use-sim"
                             disabled=move || console.conn.kind.get() == "Simulated"
@@ -444,7 +447,7 @@ mod wasm {
                         <p class="message" id="serial-message" role="status">
                             {move || message.get().unwrap_or_default()}
                         </p>
-                    })}
+                    }).map(IntoAny::into_any)}
                 </div>
             </span>
         }
