@@ -248,7 +248,7 @@ fn DataRequestCard() -> impl IntoView {
                             .enumerate()
                             .filter(|(_, n)| **n != "Reserved")
                             .map(|(i, n)| view! { <option value=i.to_string()>{*n}</option> })
-                            .map(IntoAny::into_any).collect_view()}
+                            .collect_view()}
                     </select>
                 </label>
                 <label>
@@ -407,7 +407,7 @@ fn Indications() -> impl IntoView {
                                     <td class="hex">{spaced(&payload(&e))}</td>
                                 </tr>
                             }
-                        }).map(IntoAny::into_any).collect_view()}
+                        }).collect_view()}
                 </tbody>
             </table>
         </article>

@@ -44,7 +44,6 @@ fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoView {
                 </tr>
             }
         })
-        .map(IntoAny::into_any)
         .collect_view()
 }
 
@@ -316,7 +315,7 @@ fn CountersCard() -> impl IntoView {
                 {[index::PHY_DATA, index::DL_DATA, index::SS_DATA]
                     .into_iter()
                     .map(|i| view! { <Counters index=i/> })
-                    .map(IntoAny::into_any).collect_view()}
+                    .collect_view()}
             </div>
         </article>
     }

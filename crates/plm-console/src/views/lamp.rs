@@ -28,7 +28,6 @@ fn pin_boxes(mask: RwSignal<u8>, id: &'static str) -> impl IntoView {
                 />
             }
         })
-        .map(IntoAny::into_any)
         .collect_view()
 }
 
@@ -160,7 +159,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 <figcaption>{format!("{name} {range}")}</figcaption>
                                 <svg viewBox="0 0 300 60" preserveAspectRatio="none"><polyline points=line/></svg>
                             </figure>
-                        }).map(IntoAny::into_any).collect_view()}
+                        }).collect_view()}
                         <div class="form-row">
                             {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
                             <label>
@@ -206,7 +205,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             <select on:change=move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2))>
                                 {plm_core::app::service::PROG_GROUPS.iter().enumerate().map(|(i, n)| view! {
                                     <option value=i.to_string() selected=i == 2>{*n}</option>
-                                }).map(IntoAny::into_any).collect_view()}
+                                }).collect_view()}
                             </select>
                             {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters"))}
                             <button id="lamp-params-write" on:click=move |_| {
@@ -226,7 +225,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 {button("lamp-sim-cut", "Cut supply", "", move || sim(LampAction::Cut))}
                                 {button("", "Restore supply", "", move || sim(LampAction::Join))}
                             </div>
-                        }).map(IntoAny::into_any)}
+                        })}
                         <p class="muted" id="lamp-note">{move || note.get().unwrap_or_default()}</p>
                     }.into_any()
                 }

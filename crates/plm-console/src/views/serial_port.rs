@@ -302,7 +302,6 @@ mod wasm {
                         </option>
                     }
                 })
-                .map(IntoAny::into_any)
                 .collect_view()
                 .into_any()
         };
@@ -315,7 +314,6 @@ mod wasm {
                     </option>
                 }
             })
-            .map(IntoAny::into_any)
             .collect_view();
         let polarities = TReqPolarity::ALL
             .into_iter()
@@ -326,7 +324,6 @@ mod wasm {
                     </option>
                 }
             })
-            .map(IntoAny::into_any)
             .collect_view();
         let controls = if supported {
             view! {
@@ -433,7 +430,7 @@ mod wasm {
                             >
                                 {move || if active() { "Reconnect" } else { "Connect over WebSerial" }}
                             </button>
-                        }).map(IntoAny::into_any)}
+                        })}
                         <button
                             id="serial-use-sim"
                             disabled=move || console.conn.kind.get() == "Simulated"
@@ -447,7 +444,7 @@ mod wasm {
                         <p class="message" id="serial-message" role="status">
                             {move || message.get().unwrap_or_default()}
                         </p>
-                    }).map(IntoAny::into_any)}
+                    })}
                 </div>
             </span>
         }

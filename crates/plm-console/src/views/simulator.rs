@@ -56,7 +56,7 @@ pub fn SimulatorView() -> impl IntoView {
         <div class="cards">
             // Echoing peers belong to the bare-modem world; a street has
             // its own card.
-            {move || (!profile.get().is_street()).then(|| view! { <TopologyCard/> }).map(IntoAny::into_any)}
+            {move || (!profile.get().is_street()).then(|| view! { <TopologyCard/> })}
             <StreetCard/>
             <ModemFaultsCard/>
             <LineCard/>
@@ -92,7 +92,7 @@ fn StreetCard() -> impl IntoView {
                         .map(|n| view! {
                             <option value=n.to_string() selected=move || choice.get() == n>{n.to_string()}</option>
                         })
-                        .map(IntoAny::into_any).collect_view()}
+                        .collect_view()}
                 </select>
             </label>
             <button id="sim-apply-street" on:click=move |_| {
@@ -181,7 +181,7 @@ fn TopologyCard() -> impl IntoView {
                                 </option>
                             }
                         })
-                        .map(IntoAny::into_any).collect_view()}
+                        .collect_view()}
                 </select>
             </label>
             <button id="sim-apply-topology" on:click=move |_| {
@@ -390,7 +390,7 @@ fn LineEventsCard() -> impl IntoView {
                 } else {
                     view! {
                         <ul class="events">
-                            {events.iter().rev().map(|e| view! { <li>{e.clone()}</li> }).map(IntoAny::into_any).collect_view()}
+                            {events.iter().rev().map(|e| view! { <li>{e.clone()}</li> }).collect_view()}
                         </ul>
                     }
                         .into_any()

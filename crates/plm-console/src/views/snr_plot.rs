@@ -330,7 +330,6 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </text>
             }
         })
-        .map(IntoAny::into_any)
         .collect_view();
     let x_ticks = plot
         .x_ticks
@@ -343,7 +342,6 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </text>
             }
         })
-        .map(IntoAny::into_any)
         .collect_view();
     let legend = plot
         .legend
@@ -361,7 +359,6 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </text>
             }
         })
-        .map(IntoAny::into_any)
         .collect_view();
     let markers = plot
         .markers
@@ -378,7 +375,6 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </circle>
             }
         })
-        .map(IntoAny::into_any)
         .collect_view();
     let middle = (TOP + BOTTOM) / 2.0;
     view! {

@@ -65,7 +65,7 @@ pub fn StreetView() -> impl IntoView {
             <GroupActions selected=selected message=message/>
             {move || (message.with(|m| m.is_some())).then(|| view! {
                 <p class="message" id="street-message">{move || message.get().unwrap_or_default()}</p>
-            }).map(IntoAny::into_any)}
+            })}
             <Alerts focus=focus/>
             <div class="street-grid" class:with-lamp=move || focus.with(|f| f.is_some())>
                 <div class="table-wrap">
@@ -106,7 +106,7 @@ pub fn StreetView() -> impl IntoView {
                                             </th>
                                         }
                                     })
-                                    .map(IntoAny::into_any).collect_view()}
+                                    .collect_view()}
                             </tr>
                         </thead>
                         <tbody>
@@ -154,7 +154,7 @@ pub fn StreetView() -> impl IntoView {
                                                     };
                                                     view! { <td class=cls data-key=key>{cell}</td> }
                                                 })
-                                                .map(IntoAny::into_any).collect_view()}
+                                                .collect_view()}
                                         </tr>
                                     }
                                 }
@@ -169,11 +169,11 @@ pub fn StreetView() -> impl IntoView {
                                 "No lamp matches. Discover finds the lamps on the line."
                             }}
                         </p>
-                    }).map(IntoAny::into_any)}
+                    })}
                 </div>
                 {move || (focus.with(|f| f.is_some())).then(|| view! {
                     <super::lamp::LampPanel focus=focus/>
-                }).map(IntoAny::into_any)}
+                })}
             </div>
         </div>
     }
@@ -329,10 +329,10 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 {format!(" {} (at {})", r.alert.what, r.wall)}
                             </li>
                         }
-                    }).map(IntoAny::into_any).collect_view()}
+                    }).collect_view()}
                 </ul>
             </div>
-        }).map(IntoAny::into_any)}
+        })}
     }
 }
 

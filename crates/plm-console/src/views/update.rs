@@ -155,7 +155,7 @@ pub fn UpdateView() -> impl IntoView {
                     {button("update-resume", "Resume update", "", resume)}
                     {button("update-discard", "Discard", "the boards keep what they run; segments they hold are dropped at the next update", discard)}
                 </div>
-            }).map(IntoAny::into_any)}
+            })}
             <div class="toolbar">
                 <label>
                     "Image file "
@@ -244,7 +244,6 @@ fn target_options(street: StreetStore, choice: RwSignal<String>) -> impl IntoVie
             let selected = value == current;
             view! { <option value=value selected=selected>{label}</option> }
         })
-        .map(IntoAny::into_any)
         .collect_view()
 }
 
@@ -365,7 +364,7 @@ fn Progress() -> impl IntoView {
                                     <td><progress max="1000" value=pm.to_string()></progress></td>
                                     <td>{words.clone()}</td>
                                 </tr>
-                            }).map(IntoAny::into_any).collect_view()}
+                            }).collect_view()}
                         </tbody>
                     </table>
                 </div>
