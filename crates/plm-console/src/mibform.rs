@@ -273,7 +273,7 @@ pub fn profile_json(chip: &dyn Chip, values: &MibValues) -> String {
     for o in chip.mib().iter().filter(in_profile) {
         if let Some(v) = values.get(&o.index) {
             objects.insert(
-                index_text(chip.dialect(), o.index).to_lowercase(),
+                index_text(chip.dialect(), o.index).to_ascii_lowercase(),
                 Json::String(plm_core::hex::encode(v)),
             );
         }

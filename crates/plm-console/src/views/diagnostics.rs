@@ -234,7 +234,7 @@ fn FirmwareCard() -> impl IntoView {
                 "Read"
             </button>
             <p id="firmware-value" class="big">
-                {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_uppercase()))}
+                {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_ascii_uppercase()))}
             </p>
             <p class="problem">{move || message.get()}</p>
         </article>

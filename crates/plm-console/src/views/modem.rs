@@ -301,7 +301,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
     let writable = object.access.write;
 
     view! {
-        <article class="card mib" id=format!("mib-{}", mibform::index_text(dialect, idx).to_lowercase())>
+        <article class="card mib" id=format!("mib-{}", mibform::index_text(dialect, idx).to_ascii_lowercase())>
             <header>
                 <h3>
                     <span class="index">{format!("{}h", mibform::index_text(dialect, idx))}</span>
