@@ -782,6 +782,37 @@ fn the_same_frame_again_right_after_the_ack_is_a_new_frame() {
     assert!(sim.host_events_where(is_repeat).is_empty());
 }
 
+#[test]
+fn the_same_answer_to_a_request_asked_again_is_a_new_frame() {
+    // The host reads one object, then asks for it again a few ms after
+    // its ACK of the answer (a user clicking Read twice, a chained read):
+    // the second answer, equal to the first, comes in the window where a
+    // repeat could (T_WBC + 1 character .. 2 x T_WBC + 1 character after
+    // the ACK). But the modem ACKed the request in between, which it does
+    // not while it waits to repeat: it is the answer, not a repeat.
+    for gap in [MS, 3 * MS, 4 * MS, 5 * MS, 6 * MS, 8 * MS] {
+        let mut sim = sim();
+        let req = read_db();
+        sim.submit(req.clone());
+        sim.run_to_idle();
+        let ack = sim
+            .wire(Dir::HostToDev)
+            .filter(|w| w.part == Part::Ack)
+            .map(|w| w.start)
+            .last()
+            .expect("the answer ACKed");
+        sim.run_until(ack + gap);
+        sim.submit(req.clone());
+        sim.run_to_idle();
+        assert_eq!(
+            sim.host_frames(),
+            vec![confirm(&req), confirm(&req)],
+            "asked again {gap} µs after the ACK"
+        );
+        assert!(sim.host_events_where(is_repeat).is_empty());
+    }
+}
+
 // ---- 8. a modem frame while the host waits for the status ----------------------------
 
 #[test]

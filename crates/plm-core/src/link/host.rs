@@ -439,6 +439,12 @@ impl HostEngine {
             }
             Element::Ack => {
                 if let State::AwaitAck { .. } = self.state {
+                    // A modem that waits to repeat a frame takes no host
+                    // frame (device engine, AwaitRepeat): having ACKed
+                    // this one, it repeats nothing, and a frame equal to
+                    // the one accepted before is new (the answer to the
+                    // same request asked again).
+                    self.last_accepted = None;
                     if let Some(p) = self.current.take() {
                         self.events.push_back(Event::Delivered(p.ticket));
                     }
