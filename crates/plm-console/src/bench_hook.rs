@@ -13,6 +13,9 @@
 //!   firstError, dataLen, elapsedMs}` on the page's clock.
 //! - `plmBench.ackLatency()`: [`crate::session::AckLatency`] in ms, with
 //!   the T_ACK in use: `{count, link: {p50, p99, max}, page: {…}, tAck}`.
+//! - `plmBench.ackSamples()`: the most recent ACK latencies one by one,
+//!   `[[writtenMs, linkMs, pageMs], …]`, `writtenMs` on the page's clock
+//!   (`performance.now()`) when the tick that wrote the ACK began.
 
 use crate::session::{Outcome, Spread};
 use crate::stores::{page_now_us, refusal, unexpected, Console};
@@ -40,13 +43,16 @@ pub fn install(c: Console) {
         move |n: u32, index: u8, chained: bool| mib_reads(c, n, index, chained),
     );
     let ack_latency = Closure::<dyn Fn() -> JsValue>::new(move || ack_latency(c));
+    let ack_samples = Closure::<dyn Fn() -> JsValue>::new(move || ack_samples(c));
     let _ = Reflect::set(&hook, &"setBaud".into(), set_baud.as_ref());
     let _ = Reflect::set(&hook, &"mibReads".into(), mib_reads.as_ref());
     let _ = Reflect::set(&hook, &"ackLatency".into(), ack_latency.as_ref());
+    let _ = Reflect::set(&hook, &"ackSamples".into(), ack_samples.as_ref());
     // The page keeps them for its whole life.
     set_baud.forget();
     mib_reads.forget();
     ack_latency.forget();
+    ack_samples.forget();
     let _ = Reflect::set(&window, &"plmBench".into(), &hook);
 }
 
@@ -80,6 +86,18 @@ fn ack_latency(c: Console) -> JsValue {
         ("page", spread(l.page)),
         ("tAck", ms(c.conn.timeouts.get_untracked().t_ack).into()),
     ])
+}
+
+fn ack_samples(c: Console) -> JsValue {
+    let all = js_sys::Array::new();
+    for (written, link, page) in c.ack_samples() {
+        let row = js_sys::Array::new();
+        row.push(&(written / 1_000.0).into());
+        row.push(&ms(link).into());
+        row.push(&ms(page).into());
+        all.push(&row);
+    }
+    all.into()
 }
 
 /// One run of `mibReads`.

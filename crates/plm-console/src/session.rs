@@ -302,20 +302,24 @@ struct AckTimes {
     count: u64,
     /// (transport's clock, page's clock), oldest first.
     samples: VecDeque<(Duration, Duration)>,
+    /// When each was written, on the page's clock (µs, the page's origin).
+    written: VecDeque<f64>,
     /// The transport's clock's and the page's, each in order.
     link: Vec<Duration>,
     page: Vec<Duration>,
 }
 
 impl AckTimes {
-    fn record(&mut self, link: Duration, page: Duration) {
+    fn record(&mut self, link: Duration, page: Duration, written: f64) {
         if self.samples.len() == ACK_SAMPLES {
+            self.written.pop_front();
             if let Some((l, p)) = self.samples.pop_front() {
                 take_out(&mut self.link, l);
                 take_out(&mut self.page, p);
             }
         }
         self.samples.push_back((link, page));
+        self.written.push_back(written);
         put_in(&mut self.link, link);
         put_in(&mut self.page, page);
         self.count += 1;
@@ -392,6 +396,8 @@ pub struct Session {
     log_offset: i64,
     /// The page's clock at the current tick, on the transport's clock.
     page_now: Instant,
+    /// The page's clock (µs) at the tick running now.
+    tick_at: f64,
     ack_times: AckTimes,
     /// Requests in a row whose T_REQ went unanswered at least once.
     unanswered: u8,
@@ -414,6 +420,7 @@ impl Session {
             pacer: Pacer::default(),
             log_offset: 0,
             page_now: 0,
+            tick_at: 0.0,
             ack_times: AckTimes::default(),
             unanswered: 0,
             shown: 0.0,
@@ -493,6 +500,16 @@ impl Session {
         self.ack_times.stats()
     }
 
+    /// The most recent ACK latencies one by one, oldest first: when the
+    /// tick that wrote the ACK began (µs of the page's clock), the latency
+    /// on the transport's clock and on the page's (for the bench, to find
+    /// what held up the late ones).
+    pub fn ack_samples(&self) -> Vec<(f64, Duration, Duration)> {
+        let times = self.ack_times.samples.iter();
+        let at = self.ack_times.written.iter();
+        at.zip(times).map(|(&w, &(l, p))| (w, l, p)).collect()
+    }
+
     /// Requests not yet answered (the one outstanding and those queued).
     pub fn outstanding(&self) -> usize {
         self.queue.len() + self.active.is_some() as usize
@@ -534,11 +551,19 @@ impl Session {
             let busy = self.world_due();
             let target = self.pacer.target_within(page_us, start, catch_up, busy);
             self.page_now = self.pacer.page_now();
+            self.tick_at = page_us;
             self.run_until(start, target, budget);
         }
-        // Replies at once; notes at most once per SHOW_EVERY (the page
-        // redraws no faster, and a redraw per frame on the line would hold
-        // up the next ACK).
+        self.take_due(page_us)
+    }
+
+    /// What happened since the last call, without letting time pass:
+    /// replies at once, notes at most once per SHOW_EVERY of the page's
+    /// clock `page_us` (the page redraws no faster, and a redraw per frame
+    /// on the line would hold up the next ACK: chained requests, each
+    /// sent from the previous one's reply, used to hand the notes out and
+    /// redraw once per exchange).
+    pub fn take_due(&mut self, page_us: f64) -> Tick {
         if page_us < self.shown + SHOW_EVERY {
             return Tick {
                 notes: Vec::new(),
@@ -718,6 +743,7 @@ impl Session {
                     self.ack_times.record(
                         written.saturating_sub(now),
                         self.page_now.max(written).saturating_sub(now),
+                        self.tick_at,
                     );
                 }
                 self.traffic(now, &el, Source::Host)
@@ -1162,13 +1188,13 @@ mod tests {
         assert_eq!((one.p50, one.p99, one.max), (7, 7, 7));
         let mut backwards = AckTimes::default();
         for i in (1..=100).rev() {
-            backwards.record(i, i);
+            backwards.record(i, i, 0.0);
         }
         let hundred = backwards.stats().link;
         assert_eq!((hundred.p50, hundred.p99, hundred.max), (50, 99, 100));
         let mut t = AckTimes::default();
         for i in 0..ACK_SAMPLES as u64 + 500 {
-            t.record(i, 2 * i);
+            t.record(i, 2 * i, i as f64);
         }
         let l = t.stats();
         assert_eq!(l.count, ACK_SAMPLES as u64 + 500);

@@ -539,6 +539,11 @@ impl Console {
         self.session().borrow().ack_latency()
     }
 
+    /// [`crate::session::Session::ack_samples`].
+    pub fn ack_samples(&self) -> Vec<(f64, plm_core::time::Duration, plm_core::time::Duration)> {
+        self.session().borrow().ack_samples()
+    }
+
     /// Lets time pass up to the page's clock, then asks to be run again
     /// when something is next due ([`crate::wake`]).
     pub fn tick(&self) {
@@ -567,7 +572,7 @@ impl Console {
     /// sessions run at once (a request may wait to be sent).
     fn refresh(&self) {
         crate::wake::soon();
-        let tick = self.session().borrow_mut().take();
+        let tick = self.session().borrow_mut().take_due(page_now_us());
         let street = self.street.session().borrow_mut().take();
         let (state, kind, port) = self.with_active(|t, state| {
             let (kind, port) = t.map_or((String::new(), String::new()), |t| {
@@ -685,10 +690,13 @@ impl Console {
     fn apply(&self, tick: Tick) {
         let Tick { notes, replies } = tick;
         let mut traffic = Vec::new();
+        // The last status message only: the views show the latest, and
+        // each one set redrew them (one per exchange).
+        let mut status = None;
         for n in notes {
             match n {
                 Note::Traffic { at, decoded } => traffic.push((at, *decoded)),
-                Note::Status { at, byte } => self.modem.status.set(Some((at, byte))),
+                Note::Status { at, byte } => status = Some((at, byte)),
                 Note::TReq(level) => set_if_changed(self.conn.treq, level),
                 Note::Unsolicited {
                     at,
@@ -711,6 +719,9 @@ impl Console {
                     }
                 }
             }
+        }
+        if status.is_some() {
+            self.modem.status.set(status);
         }
         if !traffic.is_empty() {
             self.traffic.log.update(|log| {
