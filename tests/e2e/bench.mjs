@@ -18,9 +18,19 @@
 // The page is driven through `window.plmBench` (crates/plm-console/src/
 // bench_hook.rs), so the figures are the session's, not a script's clicks.
 // PLM_DIST (another build directory), PLM_BENCH_READS (default 300) and
-// CHROMIUM override the defaults.
+// CHROMIUM override the defaults; PLM_BENCH_STREET=0 leaves the street out
+// (the modem figures only), PLM_BENCH_CAUSES=1 runs the reads once more
+// under Chromium's tracing and says, for each ACK later than 1 ms, what
+// the page's main thread did meanwhile.
+//
+// The ACK figure on the page's clock includes how late the machine ran the
+// page. So the same page also times a bare wake loop like the console's
+// (a timer for the whole milliseconds, then messages) right after the
+// reads: its lateness is the machine's own noise in that run, printed
+// beside the ACK figure with the load average.
 
 import fs from 'node:fs/promises';
+import os from 'node:os';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { artifacts, dist, launchChromium, serveDist, pageErrors } from './harness.mjs';
@@ -41,6 +51,10 @@ const STREET_MEASURE_MS = 20_000;
 const FRAME_MS = 1000 / 60;
 /** The console's size budget, gzipped, everything included (DESIGN.md). */
 const BUDGET = 350 * 1024;
+/** How long the bare wake loop runs. */
+const NOISE_MS = 5_000;
+/** ACKs later than this are looked into (PLM_BENCH_CAUSES). */
+const LATE_MS = 1;
 
 
 const kib = (n) => `${(n / 1024).toFixed(1)} KiB`;
@@ -86,6 +100,121 @@ async function exchange(page) {
   return parts;
 }
 
+/**
+ * The machine's own lateness: a loop in the page that waits for deadlines
+ * 0.2-3 ms ahead as the console's wake does (src/wake.rs: a timer for the
+ * whole milliseconds, the rest by messages to itself) and records how late
+ * it ran, with nothing else to do.
+ */
+async function wakeNoise(page) {
+  const late = await page.evaluate(
+    (ms) =>
+      new Promise((resolve) => {
+        const out = [];
+        const end = performance.now() + ms;
+        let due = 0;
+        let seed = 1;
+        const rand = () => ((seed = (seed * 48271) % 2147483647) / 2147483647);
+        const next = () => {
+          due = performance.now() + (0.2 + rand() * 2.8);
+          arm();
+        };
+        const arm = () => {
+          const now = performance.now();
+          if (now >= due - 0.1) {
+            out.push(now - due);
+            if (now < end) next();
+            else resolve(out);
+            return;
+          }
+          const left = due - now;
+          const whole = left < 2 ? Math.floor(left) : Math.ceil(left);
+          if (whole < 1) postMessage('plm-noise', '*');
+          else setTimeout(arm, whole);
+        };
+        addEventListener('message', (e) => e.data === 'plm-noise' && arm());
+        next();
+      }),
+    NOISE_MS,
+  );
+  return spreadOf(late.map((x) => Math.max(0, x)));
+}
+
+function spreadOf(xs) {
+  const v = [...xs].sort((a, b) => a - b);
+  const at = (p) => v[Math.min(v.length - 1, Math.max(0, Math.ceil((v.length * p) / 100) - 1))];
+  return { n: v.length, p50: at(50), p99: at(99), max: v[v.length - 1] };
+}
+
+/**
+ * What the page's main thread did while each late ACK waited: the reads
+ * run again under Chromium's tracing; for each ACK later than LATE_MS,
+ * the trace's tasks, garbage collections and rendering between the
+ * frame's last byte (on the page's clock) and the tick that ACKed it.
+ */
+async function lateCauses(browser, page, reads) {
+  const before = await page.evaluate(() => window.plmBench.ackLatency().count);
+  await browser.startTracing(page, {
+    categories: ['devtools.timeline', 'disabled-by-default-devtools.timeline', 'v8', 'blink.user_timing', 'toplevel'],
+  });
+  const sync = await page.evaluate(() => {
+    performance.mark('plm-bench-sync');
+    return performance.getEntriesByName('plm-bench-sync').at(-1).startTime;
+  });
+  await reads(READS, true);
+  const samples = await page.evaluate(() => window.plmBench.ackSamples());
+  const after = await page.evaluate(() => window.plmBench.ackLatency().count);
+  const trace = JSON.parse((await browser.stopTracing()).toString());
+  const events = trace.traceEvents ?? trace;
+  const mark = events.find((e) => e.name === 'plm-bench-sync');
+  if (!mark) return ['causes: no sync mark in the trace'];
+  const main = events.find((e) => e.name === 'thread_name' && e.args?.name === 'CrRendererMain' && e.pid === mark.pid);
+  const tid = main ? main.tid : mark.tid;
+  // Trace µs -> page ms.
+  const toPage = (ts) => (ts - mark.ts) / 1000 + sync;
+  const spans = events
+    .filter((e) => e.pid === mark.pid && e.tid === tid && e.ph === 'X' && e.dur !== undefined)
+    .map((e) => ({ name: e.name, t0: toPage(e.ts), t1: toPage(e.ts + e.dur), args: e.args }));
+  const isGc = (n) => /GC|Scavenge|MarkCompact|V8\.GC/.test(n);
+  const isTask = (n) => n === 'ThreadControllerImpl::RunTask' || n === 'RunTask';
+  const isRender = (n) => /^(UpdateLayoutTree|Layout|Paint|PrePaint|Layerize|Commit|UpdateLayer|HitTest|ParseHTML|RecalculateStyles|IntersectionObserverController::computeIntersections)$/.test(n);
+  const newest = samples.slice(-(after - before));
+  const late = newest.filter(([, , p]) => p > LATE_MS);
+  const causes = { gc: 0, render: 0, otherTask: 0, ourTick: 0, idle: 0 };
+  const lines = [];
+  for (const [written, , pageMs] of late) {
+    const from = written - pageMs;
+    const over = (s) => Math.max(0, Math.min(s.t1, written) - Math.max(s.t0, from));
+    const inWin = spans.filter((s) => over(s) > 0);
+    const gc = inWin.filter((s) => isGc(s.name)).reduce((a, s) => a + over(s), 0);
+    const render = inWin.filter((s) => isRender(s.name)).reduce((a, s) => a + over(s), 0);
+    const tasks = inWin.filter((s) => isTask(s.name));
+    const busy = tasks.reduce((a, s) => a + over(s), 0);
+    // The task that ran the tick that ACKed: the last one starting before `written`.
+    const top = inWin
+      .filter((s) => !isTask(s.name) && !isGc(s.name) && over(s) > 0.2)
+      .sort((a, b) => over(b) - over(a))
+      .slice(0, 3)
+      .map((s) => `${s.name}${s.args?.data?.type ? `(${s.args.data.type})` : ''} ${over(s).toFixed(2)}`);
+    let cause;
+    if (gc > 0.3 * pageMs) cause = 'gc';
+    else if (render > 0.3 * pageMs) cause = 'render';
+    else if (busy > 0.5 * pageMs) cause = 'otherTask';
+    else cause = 'idle';
+    causes[cause] += 1;
+    lines.push(
+      `    ${pageMs.toFixed(2).padStart(6)} ms at ${written.toFixed(1)}: main thread busy ${busy.toFixed(2)} (gc ${gc.toFixed(2)}, render ${render.toFixed(2)}) -> ${cause}; ${top.join(', ')}`,
+    );
+  }
+  const all = spreadOf(newest.map(([, , p]) => p));
+  return [
+    `ACKs later than ${LATE_MS} ms under tracing (${READS} chained reads, ${newest.length} ACKs, page p50 ${msText(all.p50)} p99 ${msText(all.p99)} max ${msText(all.max)}): ${late.length}`,
+    `  by what the main thread did meanwhile: ${Object.entries(causes).map(([k, v]) => `${k} ${v}`).join(', ')}`,
+    '  (idle: the thread ran nothing between the byte and the tick: the wake itself came late)',
+    ...lines.slice(0, 40),
+  ];
+}
+
 /** Frame times of the Street view on a 500-lamp street. */
 async function streetFrames(browser, base) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
@@ -127,6 +256,7 @@ async function streetFrames(browser, base) {
 async function main() {
   const { server, base } = await serveDist();
   const browser = await launchChromium();
+  const loadBefore = os.loadavg();
   try {
     const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
     const errors = pageErrors(page);
@@ -151,6 +281,9 @@ async function main() {
     const queued = checked(await reads(READS, false), 'queued reads');
     const chained = checked(await reads(READS, true), 'chained reads');
     const ack = await page.evaluate(() => window.plmBench.ackLatency());
+    const noise = await wakeNoise(page);
+    const causes = process.env.PLM_BENCH_CAUSES === '1' ? await lateCauses(browser, page, reads) : [];
+    const loadAfter = os.loadavg();
     await page.screenshot({ path: path.join(artifacts, 'bench-diagnostics.png') });
     // The exchange as the Traffic tab shows it (a hidden table is left as it was).
     await page.click('#tab-traffic');
@@ -159,7 +292,7 @@ async function main() {
     );
     const parts = await exchange(page);
     if (errors.length) throw new Error(`errors in the page: ${errors.join('; ')}`);
-    const street = await streetFrames(browser, base);
+    const street = process.env.PLM_BENCH_STREET === '0' ? null : await streetFrames(browser, base);
 
     const bytes = parts.reduce((n, p) => n + p.bytes, 0);
     const wireMs = (bytes * BITS_PER_BYTE * 1000) / BAUD;
@@ -181,6 +314,9 @@ async function main() {
       `ACK latency, last byte of a modem frame to the host's ACK (${ack.count} frames; T_ACK ${ack.tAck} ms):`,
       `  page's clock   ${spread(ack.page)}   (includes how late the page woke, and stalls)`,
       `  virtual link   ${spread(ack.link)}   (what the simulated modem saw: its time waits for the page)`,
+      `  machine noise  ${spread(noise)}   (a bare wake loop as the console's, ${noise.n} wakes right after, same page)`,
+      `  load average ${loadBefore.map((x) => x.toFixed(2)).join(' ')} before, ${loadAfter.map((x) => x.toFixed(2)).join(' ')} after (${os.cpus().length} cores)`,
+      ...causes,
       '',
       `MIB reads (MIB_ReadRequest ${MIB_INDEX.toString(16).padStart(2, '0').toUpperCase()}h, ${queued.dataLen}-byte value), ${READS} each:`,
       `  queued   ${READS} in ${msText(queued.elapsedMs)} = ${rate(queued).toFixed(0)} /s (${pct(rate(queued))}; the session sends the next on each answer)`,
@@ -188,8 +324,12 @@ async function main() {
       `  wire-time limit: ${parts.map((p) => `${p.name} ${p.bytes}`).join(' + ')} = ${bytes} bytes`,
       `    x ${BITS_PER_BYTE} bits / ${BAUD} baud = ${wireMs.toFixed(2)} ms -> ${limit.toFixed(0)} round trips /s`,
       '',
-      `Street view, ${street.rows} of ${STREET_LAMPS} lamps in the table (${street.progress}), ${street.n} frames over ${STREET_MEASURE_MS / 1000} s:`,
-      `  frame time p50 ${msText(street.p50)} (ratio ${(street.p50 / FRAME_MS).toFixed(2)} of a 60 fps frame)   p99 ${msText(street.p99)} (ratio ${(street.p99 / FRAME_MS).toFixed(2)})   max ${msText(street.max)}`,
+      ...(street
+        ? [
+            `Street view, ${street.rows} of ${STREET_LAMPS} lamps in the table (${street.progress}), ${street.n} frames over ${STREET_MEASURE_MS / 1000} s:`,
+            `  frame time p50 ${msText(street.p50)} (ratio ${(street.p50 / FRAME_MS).toFixed(2)} of a 60 fps frame)   p99 ${msText(street.p99)} (ratio ${(street.p99 / FRAME_MS).toFixed(2)})   max ${msText(street.max)}`,
+          ]
+        : ['Street view: left out (PLM_BENCH_STREET=0)']),
       '',
       'Size, gzip -9:',
       ...dsizes.map((r) => `  ${r.file.padEnd(40)} ${kib(r.raw).padStart(10)} -> ${kib(r.gz).padStart(9)}`),
