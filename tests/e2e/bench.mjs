@@ -176,11 +176,13 @@ async function lateCauses(browser, page, reads) {
     .filter((e) => e.pid === mark.pid && e.tid === tid && e.ph === 'X' && e.dur !== undefined)
     .map((e) => ({ name: e.name, t0: toPage(e.ts), t1: toPage(e.ts + e.dur), args: e.args }));
   const isGc = (n) => /GC|Scavenge|MarkCompact|V8\.GC/.test(n);
-  const isTask = (n) => n === 'ThreadControllerImpl::RunTask' || n === 'RunTask';
+  // One name per task (Chromium nests RunTask in ThreadControllerImpl::RunTask).
+  const taskName = spans.some((s) => s.name === 'ThreadControllerImpl::RunTask') ? 'ThreadControllerImpl::RunTask' : 'RunTask';
+  const isTask = (n) => n === taskName;
   const isRender = (n) => /^(UpdateLayoutTree|Layout|Paint|PrePaint|Layerize|Commit|UpdateLayer|HitTest|ParseHTML|RecalculateStyles|IntersectionObserverController::computeIntersections)$/.test(n);
   const newest = samples.slice(-(after - before));
   const late = newest.filter(([, , p]) => p > LATE_MS);
-  const causes = { gc: 0, render: 0, otherTask: 0, ourTick: 0, idle: 0 };
+  const causes = { gc: 0, render: 0, otherTask: 0, idle: 0 };
   const lines = [];
   for (const [written, , pageMs] of late) {
     const from = written - pageMs;
@@ -190,7 +192,7 @@ async function lateCauses(browser, page, reads) {
     const render = inWin.filter((s) => isRender(s.name)).reduce((a, s) => a + over(s), 0);
     const tasks = inWin.filter((s) => isTask(s.name));
     const busy = tasks.reduce((a, s) => a + over(s), 0);
-    // The task that ran the tick that ACKed: the last one starting before `written`.
+    // What ran longest meanwhile (the tasks themselves left out).
     const top = inWin
       .filter((s) => !isTask(s.name) && !isGc(s.name) && over(s) > 0.2)
       .sort((a, b) => over(b) - over(a))

@@ -135,16 +135,25 @@ fn PingCard() -> impl IntoView {
 #[component]
 fn StatusCard() -> impl IntoView {
     let c = use_console();
+    let byte = Memo::new(move |_| c.modem.status.get().map(|(_, b)| b));
+    let received = move || {
+        c.modem
+            .status
+            .get()
+            .map(|(at, b)| format!("3F {b:02X}, received at {}", seconds(at)))
+    };
     view! {
         <article class="card" id="status">
             <h3>"Status message"</h3>
             <p class="muted">
                 "The bits of the last status message (UM0932 Table 8); the modem sends one each time the host asks to send."
             </p>
-            {move || match c.modem.status.get() {
+            // The table is drawn again only when the byte changes; the
+            // time of the last one is a text (one status per exchange).
+            {move || match byte.get() {
                 None => view! { <p class="muted">"No status message yet: send any request."</p> }.into_any(),
-                Some((at, byte)) => view! {
-                    <p>{format!("3F {byte:02X}, received at {}", seconds(at))}</p>
+                Some(byte) => view! {
+                    <p>{received}</p>
                     <table class="kv">{field_rows(status::LAYOUT, vec![byte])}</table>
                 }
                 .into_any(),
@@ -164,41 +173,51 @@ fn AckLatencyCard() -> impl IntoView {
         c.ack_latency()
     });
     let simulated = move || c.conn.kind.get() == "Simulated";
+    let none = Memo::new(move |_| latency.with(|l| l.count == 0));
+    let t_ack = move || c.conn.timeouts.get().t_ack;
+    let line = move || {
+        let p = latency.with(|l| l.page);
+        format!(
+            "ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)",
+            millis(p.p50),
+            millis(p.p99),
+            millis(p.max),
+            t_ack() / MS
+        )
+    };
+    let late = move || latency.with(|l| l.page.max) > t_ack();
+    let frames = move || {
+        let count = latency.with(|l| l.count);
+        if count as usize > ACK_SAMPLES {
+            format!("Over the last {ACK_SAMPLES} of {count} frames ACKed since connecting.")
+        } else {
+            format!("{count} frame(s) ACKed since connecting.")
+        }
+    };
+    let link = move || {
+        let l = latency.with(|l| l.link);
+        simulated().then(|| {
+            format!(
+                "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
+                millis(l.p99),
+                millis(l.max)
+            )
+        })
+    };
     view! {
         <article class="card" id="ack-latency">
             <h3>"ACK latency"</h3>
             <p class="muted">
                 "From the last byte of each modem frame to the host's ACK (UM0932 3.2.8), on the page's clock: it includes how late the page woke and any stall of the page."
             </p>
+            // Only the texts change as traffic comes (a redraw of the
+            // card's elements at every hand-out would hold up the next ACK
+            // longer, issue 13).
             {move || {
-                let l = latency.get();
-                let t_ack = c.conn.timeouts.get().t_ack;
-                if l.count == 0 {
+                if none.get() {
                     return view! { <p class="muted" id="ack-latency-value">"No frame from the modem yet."</p> }
                         .into_any();
                 }
-                let p = l.page;
-                let line = format!(
-                    "ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)",
-                    millis(p.p50),
-                    millis(p.p99),
-                    millis(p.max),
-                    t_ack / MS
-                );
-                let late = p.max > t_ack;
-                let frames = if l.count as usize > ACK_SAMPLES {
-                    format!("Over the last {ACK_SAMPLES} of {} frames ACKed since connecting.", l.count)
-                } else {
-                    format!("{} frame(s) ACKed since connecting.", l.count)
-                };
-                let link = simulated()
-                    .then(|| {
-                        format!(
-                            "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
-                            millis(l.link.p99),
-                            millis(l.link.max)
-                        )
-                    });
                 view! {
                     <p id="ack-latency-value" class:problem=late>
                         {line}
