@@ -25,7 +25,7 @@ use crate::transport::{LinkState, Transport};
 use plm_core::chip::{self, Chip};
 use plm_core::decode::Decoded;
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
-use plm_core::link::{Dialect, Element, LocalFrame, Source, Timeouts};
+use plm_core::link::{Dialect, Element, LocalFrame, Source, StatusMessage, Timeouts};
 use plm_core::time::{Duration, Instant, MS};
 use std::collections::VecDeque;
 
@@ -177,12 +177,12 @@ pub enum Note {
         /// The element, named as `plm decode` names it.
         decoded: Box<Decoded>,
     },
-    /// A status message arrived: the byte after `?`.
+    /// A status message arrived.
     Status {
         /// When.
         at: Instant,
-        /// The status byte (UM0932 Table 8).
-        byte: u8,
+        /// The bytes after `?` (UM0932 Table 8, ST7570 UM Table 11).
+        message: StatusMessage,
     },
     /// T_REQ changed; `true` is asserted (low).
     TReq(bool),
@@ -649,11 +649,9 @@ impl Session {
     fn on_event(&mut self, now: Instant, e: Event) {
         match e {
             Event::Received(el) => {
-                if let Element::Status(s) = &el {
-                    if let Some(&byte) = s.data().first() {
-                        let at = self.log_time(now);
-                        self.out.notes.push(Note::Status { at, byte });
-                    }
+                if let Element::Status(message) = el {
+                    let at = self.log_time(now);
+                    self.out.notes.push(Note::Status { at, message });
                 }
                 self.traffic(now, &el, Source::Modem);
             }
@@ -784,8 +782,9 @@ impl Session {
         self.out.notes.push(Note::Timeouts(timeouts));
     }
 
-    /// A time on the transport's clock as the notes give it.
-    fn log_time(&self, t: Instant) -> Instant {
+    /// A time on the transport's clock on the traffic log's (which goes
+    /// on across connections).
+    pub fn log_time(&self, t: Instant) -> Instant {
         (t as i64).saturating_add(self.log_offset).max(0) as Instant
     }
 

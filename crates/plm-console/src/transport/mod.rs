@@ -72,6 +72,10 @@ pub trait Transport {
     fn simulator(&mut self) -> Option<&mut dyn Simulator> {
         None
     }
+    /// The simulated S-FSK network behind this transport, if it is one.
+    fn sfsk(&mut self) -> Option<&mut sfsk::SfskTransport> {
+        None
+    }
 }
 
 /// What the Simulator view can do to a simulated transport.
