@@ -117,3 +117,36 @@ export async function exportImport(page, fileName, shotName) {
   if (shotName) await shot(page, shotName);
   return entries;
 }
+
+/** ST7570: the Modem view's set-up card makes the modem a MAC Client. */
+export async function macClient(page) {
+  await tab(page, 'modem');
+  await page.locator('#setup-role').selectOption('0');
+  await page.click('#setup-write');
+  const result = page.locator('#setup-result');
+  await result.filter({ hasText: /read back|not written|failed/ }).waitFor({ timeout: 10_000 });
+  assert.equal(await result.textContent(), 'MAC Client (initiator): 00A1h written, read back: the modem has it');
+}
+
+/**
+ * ST7570, MAC Client: the Data view sends "?" to Server 001h, the modem
+ * confirms LM_OK, and the Server's answer (its address and phase) is
+ * among the received frames.
+ */
+export async function macAsk(page) {
+  await tab(page, 'data');
+  await page.fill('#sfsk-da', '001');
+  await page.fill('#sfsk-payload', '?');
+  const before = await page.locator('#sfsk-received-table tbody tr').count();
+  await page.click('#sfsk-send-btn');
+  const result = page.locator('#sfsk-result');
+  await result.filter({ hasText: /^(?!sending)./ }).waitFor({ timeout: 25_000 });
+  assert.equal(await result.textContent(), 'CMD_DataConfirm: LM_OK');
+  const answers = page.locator('#sfsk-received-table tbody tr', { hasText: '001h → ' }).filter({ hasText: '"!001 phase' });
+  await page.waitForFunction(
+    (n) => document.querySelectorAll('#sfsk-received-table tbody tr').length > n,
+    before,
+    { timeout: 10_000 },
+  );
+  await answers.first().waitFor();
+}

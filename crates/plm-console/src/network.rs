@@ -173,9 +173,9 @@ impl NetworkLog {
     }
 
     /// The access layer the modem's frames are read in: the one the last
-    /// status message gave, else MAC (the factory default of 00A1h).
+    /// status message gave, else PHY (the factory default of 00A1h).
     pub fn layer(&self) -> Layer {
-        self.layer.unwrap_or(Layer::Mac)
+        self.layer.unwrap_or(Layer::Phy)
     }
 
     /// A status message came (the three bytes after `?`).
@@ -338,6 +338,12 @@ mod tests {
     #[test]
     fn a_server_s_synchronization_history_names_the_causes() {
         let mut log = NetworkLog::default();
+        let mac_server = Status {
+            mode: 2,
+            mac: true,
+            ..Status::default()
+        };
+        log.on_status(1, &mac_server.emit());
         let lost = Command::MacSynchroIndication(MacSync::Lost {
             cause: 2,
             add1: 5,

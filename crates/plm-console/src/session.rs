@@ -363,6 +363,9 @@ pub struct Session {
     unanswered: u8,
     /// When notes were last handed out, µs of the page's clock.
     shown: f64,
+    /// The modem's timeouts (MIB 09h, 000Bh, the chip's at reset); the
+    /// host engine waits them plus the transport's latency.
+    timeouts: Timeouts,
     out: Tick,
 }
 
@@ -370,7 +373,7 @@ impl Session {
     /// A session with a chip of `dialect` over `transport` (or none yet).
     pub fn new(transport: Option<Box<dyn Transport>>, dialect: Dialect) -> Self {
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
-        Session {
+        let mut s = Session {
             transport,
             host: HostEngine::new(dialect, HostConfig::at_reset(dialect, baud)),
             chip: chip::for_dialect(dialect),
@@ -383,7 +386,33 @@ impl Session {
             ack_times: AckTimes::default(),
             unanswered: 0,
             shown: 0.0,
+            timeouts: Timeouts::at_reset(dialect, baud),
             out: Tick::default(),
+        };
+        s.configure();
+        s
+    }
+
+    /// Gives the host engine the modem's timeouts, each of its waits for
+    /// the modem (T_POLL, T_ACK, and T_IC between received bytes)
+    /// lengthened by the transport's latency ([`Transport::latency`]: a
+    /// USB adapter holds received bytes and queues the host's), and tells
+    /// the transport the modem's T_IC.
+    fn configure(&mut self) {
+        let t = self.timeouts;
+        let slack = self.transport.as_ref().map_or(0, |t| t.latency());
+        let config = HostConfig {
+            timeouts: Timeouts {
+                t_poll: t.t_poll + slack,
+                t_ack: t.t_ack + slack,
+                t_ic: t.t_ic + slack,
+                ..t
+            },
+            ..self.host.config()
+        };
+        self.host.set_config(config);
+        if let Some(tr) = self.transport.as_mut() {
+            tr.set_byte_gap_limit(t.t_ic);
         }
     }
 
@@ -428,13 +457,13 @@ impl Session {
         self.host = HostEngine::new(dialect, HostConfig::at_reset(dialect, baud));
         self.chip = chip::for_dialect(dialect);
         self.transport = transport;
+        self.timeouts = Timeouts::at_reset(dialect, baud);
+        self.configure();
         self.pacer = Pacer::default();
         self.duplicate_of = None;
         self.ack_times = AckTimes::default();
         self.out.notes.push(Note::TReq(false));
-        self.out
-            .notes
-            .push(Note::Timeouts(self.host.config().timeouts));
+        self.out.notes.push(Note::Timeouts(self.timeouts));
     }
 
     /// Changes the UART baud rate of the transport and the engine.
@@ -451,7 +480,7 @@ impl Session {
 
     /// The host-interface timeouts in use.
     pub fn timeouts(&self) -> Timeouts {
-        self.host.config().timeouts
+        self.timeouts
     }
 
     /// How quickly the host has ACKed the modem's frames since connecting.
@@ -774,11 +803,8 @@ impl Session {
     }
 
     fn set_timeouts(&mut self, timeouts: Timeouts) {
-        let config = HostConfig {
-            timeouts,
-            ..self.host.config()
-        };
-        self.host.set_config(config);
+        self.timeouts = timeouts;
+        self.configure();
         self.out.notes.push(Note::Timeouts(timeouts));
     }
 

@@ -80,9 +80,9 @@ pub fn ModemView() -> impl IntoView {
                 " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>
-        <Show when=move || objects.get().1 == plm_core::link::Dialect::St7570>
-            <div class="cards"><super::sfsk_setup::SetupCard/></div>
-        </Show>
+        <div class="cards" hidden=move || objects.get().1 != plm_core::link::Dialect::St7570>
+            <super::sfsk_setup::SetupCard/>
+        </div>
         <div class="mib-list">
             {move || {
                 let (list, dialect) = objects.get();

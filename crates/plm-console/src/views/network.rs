@@ -5,7 +5,7 @@
 //! them. What it shows is [`crate::network::NetworkLog`]'s.
 
 use super::diagnostics::field_rows;
-use super::widgets::button;
+use super::widgets::{button, text_table};
 use super::{fixed, seconds};
 use crate::network::{address_text, sn_text, sync_text, Event};
 use crate::profile::Profile;
@@ -45,24 +45,18 @@ pub fn NetworkView() -> impl IntoView {
     let c = use_console();
     let st7570 = move || c.profile.get() == Profile::St7570;
     view! {
-        <Show
-            when=st7570
-            fallback=|| view! {
-                <article class="card">
-                    <p class="muted">"The Network view shows an ST7570's S-FSK network. Choose the ST7570 profile in the connection bar."</p>
-                </article>
-            }
-        >
-            <div class="cards">
-                <StatusCard/>
-                <SyncCard/>
-                <NodesCard/>
-                <AlarmCard/>
-                <RepeaterCallCard/>
-                <SpyCard/>
-                <SimulatedServers/>
-            </div>
-        </Show>
+        <article class="card" hidden=st7570>
+            <p class="muted">"The Network view shows an ST7570's S-FSK network. Choose the ST7570 profile in the connection bar."</p>
+        </article>
+        <div class="cards" hidden=move || !st7570()>
+            <StatusCard/>
+            <SyncCard/>
+            <SimulatedServers/>
+            <NodesCard/>
+            <AlarmCard/>
+            <RepeaterCallCard/>
+            <SpyCard/>
+        </div>
     }
 }
 
@@ -157,39 +151,39 @@ fn NodesCard() -> impl IntoView {
             n.heard
                 .iter()
                 .map(|(a, h)| {
-                    let credit = h
-                        .credit
-                        .map_or("–".into(), |c| format!("{}/{}/{}", c.ic, c.cc, c.dc));
-                    let snr = h.snr.map_or("–".into(), |(a, b)| {
-                        format!("{} / {}", fixed(a, 1), fixed(b, 1))
-                    });
-                    let sn = h.sn.as_ref().map_or("–".into(), sn_text);
-                    let phase = h.delta_phase.map_or("–", |d| {
-                        f::DELTA_PHASES.get(d as usize).copied().unwrap_or("?")
-                    });
-                    view! {
-                        <tr data-address=address_text(*a)>
-                            <td class="num">{address_text(*a)}</td>
-                            <td class="num">{h.frames}</td>
-                            <td class="time">{seconds(h.last)}</td>
-                            <td class="num">{credit}</td>
-                            <td class="num">{snr}</td>
-                            <td>{sn}</td>
-                            <td class="num">{phase}</td>
-                        </tr>
-                    }
+                    vec![
+                        address_text(*a),
+                        h.frames.to_string(),
+                        seconds(h.last),
+                        h.credit
+                            .map_or("–".into(), |c| format!("{}/{}/{}", c.ic, c.cc, c.dc)),
+                        h.snr.map_or("–".into(), |(a, b)| {
+                            format!("{} / {}", fixed(a, 1), fixed(b, 1))
+                        }),
+                        h.sn.as_ref().map_or("–".into(), sn_text),
+                        h.delta_phase
+                            .and_then(|d| f::DELTA_PHASES.get(d as usize))
+                            .map_or("–", |p| *p)
+                            .to_string(),
+                    ]
                 })
-                .collect_view()
+                .collect()
         })
     };
+    const COLUMNS: &[(&str, &str)] = &[
+        ("Address", "num"),
+        ("Frames", "num"),
+        ("Last heard", "time"),
+        ("IC/CC/DC", "num"),
+        ("SNR0 / SNR1 dB", "num"),
+        ("S/N", ""),
+        ("Δφ", "num"),
+    ];
     view! {
         <article class="card wide" id="net-nodes">
             <h3>"Nodes heard"</h3>
             <p class="muted">"By source address, from the frames indicated (MAC) and the subframes heard (PHY, Monitor). Δφ is the status message's delta-phase at the time (Server and Monitor)."</p>
-            <table class="log" id="net-nodes-table">
-                <thead><tr><th>"Address"</th><th>"Frames"</th><th>"Last heard"</th><th>"IC/CC/DC"</th><th>"SNR0 / SNR1 dB"</th><th>"S/N"</th><th>"Δφ"</th></tr></thead>
-                <tbody>{rows}</tbody>
-            </table>
+            {text_table("net-nodes-table", COLUMNS, Box::new(rows))}
         </article>
     }
 }
@@ -326,7 +320,8 @@ fn SpyCard() -> impl IntoView {
         })
     };
     view! {
-        <article class="card wide" id="net-spy">
+        // Only a Monitor has SPY indications (Table 15).
+        <article class="card wide" id="net-spy" hidden=move || net.with(|n| n.spy.is_empty() && n.status.is_none_or(|(_, s)| s.mode != 3))>
             <h3>"Monitor: SPY timeline"</h3>
             <p class="muted">"One mark per SPY indication, oldest first (Monitor mode, 5.3.17-5.3.22): S subframe, · no subframe, ? searching, F synchronization found, A alarm, - no alarm. Hover for S/N."</p>
             <div class="timeline" id="net-spy-timeline">{slots}</div>
@@ -374,8 +369,7 @@ fn SimulatedServers() -> impl IntoView {
             .collect_view()
     };
     view! {
-        <Show when=move || servers.with(|s| !s.is_empty())>
-            <article class="card wide" id="net-sim">
+        <article class="card wide" id="net-sim" hidden=move || servers.with(|s| s.is_empty())>
                 <h3>"Simulated line"</h3>
                 <p class="muted">"The Servers of the simulated network, as the line sees them (a real network shows only what your modem hears). They answer what is sent to them; \"Cut off\" drowns a node in noise, so that it loses synchronization once timeout-frame-not-OK (0003h) runs out."</p>
                 <div class="form-row">
@@ -395,7 +389,6 @@ fn SimulatedServers() -> impl IntoView {
                     <thead><tr><th>"Node"</th><th>"Address"</th><th>"Role"</th><th>"Now"</th><th>"Frames to it / answered"</th><th>"Last synchronization changes"</th><th></th></tr></thead>
                     <tbody>{rows}</tbody>
                 </table>
-            </article>
-        </Show>
+        </article>
     }
 }

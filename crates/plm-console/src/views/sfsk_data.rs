@@ -5,7 +5,7 @@
 
 use super::network::{code_name, send};
 use super::seconds;
-use super::widgets::{button, note, text_input};
+use super::widgets::{button, note, text_input, text_table};
 use crate::network::address_text;
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -171,25 +171,21 @@ fn ReceivedCard() -> impl IntoView {
                     let credit = r
                         .credit
                         .map_or("–".into(), |c| format!("{}/{}/{}", c.ic, c.cc, c.dc));
-                    view! {
-                        <tr>
-                            <td class="time">{seconds(r.at)}</td>
-                            <td class="num">{addr}</td>
-                            <td class="num">{credit}</td>
-                            <td class="hex">{shown(&r.payload)}</td>
-                        </tr>
-                    }
+                    vec![seconds(r.at), addr, credit, shown(&r.payload)]
                 })
-                .collect_view()
+                .collect()
         })
     };
+    const COLUMNS: &[(&str, &str)] = &[
+        ("When", "time"),
+        ("SA → DA", "num"),
+        ("IC/CC/DC", "num"),
+        ("Payload", "hex"),
+    ];
     view! {
         <article class="card wide" id="sfsk-received">
             <h3>"Received frames"</h3>
-            <table class="log" id="sfsk-received-table">
-                <thead><tr><th>"When"</th><th>"SA → DA"</th><th>"IC/CC/DC"</th><th>"Payload"</th></tr></thead>
-                <tbody>{rows}</tbody>
-            </table>
+            {text_table("sfsk-received-table", COLUMNS, Box::new(rows))}
         </article>
     }
 }

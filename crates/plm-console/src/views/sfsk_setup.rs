@@ -108,17 +108,27 @@ pub fn SetupCard() -> impl IntoView {
         };
         problem.set(None);
         result.set(Some("writing…".into()));
+        // Written, then read back (which also brings a status message of
+        // the new mode): what the modem has is what the card says.
+        let wanted = data.clone();
+        let check = move |done: String| {
+            c.read_mib(index::PLC_CONFIGURATION, move |r| {
+                result.set(Some(match r {
+                    Ok(v) if v == wanted => format!("{done}, read back: the modem has it"),
+                    Ok(_) => format!("{done}, but 00A1h reads back otherwise"),
+                    Err(why) => format!("{done}; reading it back failed: {why}"),
+                }))
+            })
+        };
         c.write_mib(index::PLC_CONFIGURATION, data, move |r| match (r, local) {
             (Err(why), _) => result.set(Some(format!("00A1h not written: {why}"))),
-            (Ok(_), None) => result.set(Some(format!("{name}: 00A1h written"))),
+            (Ok(_), None) => check(format!("{name}: 00A1h written")),
             (Ok(_), Some(a)) => {
                 let mut d = a.to_le_bytes().to_vec();
                 d.extend([0, 0]);
-                c.write_mib(index::LOCAL_INIT_MAC_ADD, d, move |r| {
-                    result.set(Some(match r {
-                        Ok(_) => format!("{name} at {a:03X}h: 00A1h and 0001h written"),
-                        Err(why) => format!("00A1h written, 0001h not: {why}"),
-                    }))
+                c.write_mib(index::LOCAL_INIT_MAC_ADD, d, move |r| match r {
+                    Ok(_) => check(format!("{name} at {a:03X}h: 00A1h and 0001h written")),
+                    Err(why) => result.set(Some(format!("00A1h written, 0001h not: {why}"))),
                 })
             }
         });
