@@ -556,6 +556,22 @@ mod tests {
             "{:?}",
             one.syncs
         );
+
+        // An alarm from Server 001h (synchronized: 0003h at 40 s again)
+        // reaches the Client's host.
+        fn net(s: &mut Session) -> &mut SfskTransport {
+            s.transport_mut().and_then(|t| t.sfsk()).unwrap()
+        }
+        net(&mut s).set_timeout_scale(1);
+        s.request(ask(), count(&confirmed));
+        run(&mut s, &mut log, 2_000);
+        net(&mut s).raise_alarm(1);
+        run(&mut s, &mut log, 3_000);
+        let alarms: Vec<&str> = log.alarms.iter().map(|e| e.what.as_str()).collect();
+        assert!(
+            matches!(alarms[..], [a] if a.starts_with("alarm received (")),
+            "{alarms:?}"
+        );
     }
 
     #[test]

@@ -81,6 +81,18 @@ impl SfskTransport {
         }
     }
 
+    /// Node `node`'s host has its modem send an alarm.
+    pub fn raise_alarm(&mut self, node: usize) {
+        if let Some(r) = self
+            .net
+            .nodes
+            .get_mut(node)
+            .and_then(|n| n.responder.as_mut())
+        {
+            r.raise_alarm();
+        }
+    }
+
     /// Every modem's MAC timeouts run `scale` times faster from now on.
     pub fn set_timeout_scale(&mut self, scale: u64) {
         self.net.set_timeout_scale(scale);

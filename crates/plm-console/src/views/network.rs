@@ -362,6 +362,10 @@ fn SimulatedServers() -> impl IntoView {
                             <button class="cut" on:click=move |_| c.with_sfsk(|t| t.cut_off(node, !cut))>
                                 {if cut { "Reconnect" } else { "Cut off" }}
                             </button>
+                            " "
+                            <button class="alarm" title="Its host sends CMD_AlarmRequest: every node hears the alarm in the window of a slot" on:click=move |_| c.with_sfsk(|t| t.raise_alarm(node))>
+                                "Alarm"
+                            </button>
                         </td>
                     </tr>
                 }

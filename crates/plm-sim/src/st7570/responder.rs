@@ -64,6 +64,12 @@ impl Responder {
         }
     }
 
+    /// Has its modem send an alarm (CMD_AlarmRequest, 5.3.15) once the
+    /// requests before it are done: what a demo shows of alarms.
+    pub fn raise_alarm(&mut self) {
+        self.queue.push_back(Command::AlarmRequest);
+    }
+
     /// Acts on the host events since the last call and sends the next
     /// request if none is waiting.
     pub fn step(&mut self, d: &mut ModemDriver) {
