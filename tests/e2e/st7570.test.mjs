@@ -6,7 +6,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { macAsk, macClient, shot, tab, titles } from './journeys.mjs';
+import { macAsk, macClient, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
 
 let server;
 let base;
@@ -68,17 +68,7 @@ test('the ST7570 is chosen in the connection bar, remembered, and configured as 
 
 test('an out-of-range ST7570 value is refused in the form with the reason, and nothing is sent', async (t) => {
   const page = await open(t, '?profile=st7570');
-  const card = page.locator('#mib-00a1');
-  await card.locator('input[name=f0]').fill('200000');
-  await card.locator('[data-action=write]').click();
-  const reason = card.locator('tr[data-field=f0] [data-role=problem]');
-  await reason.filter({ hasText: '200000 is out of range 3000..=140000 Hz' }).waitFor();
-  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
-  await shot(page, 'st7570-refused');
-  await page.waitForTimeout(300);
-  await tab(page, 'traffic');
-  const all = await titles(page);
-  assert.ok(!all.includes('CMD_WriteDBRequest'), all.join(', '));
+  await refusedFrequency(page, 'st7570-refused', ST7570_F);
 });
 
 test('a MAC Client asks a Server and sees its answer, the synchronization of that Server lost and found, and an alarm sent', async (t) => {
