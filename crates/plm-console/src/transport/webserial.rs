@@ -108,11 +108,14 @@ pub const WHOLE_FRAMES_BELOW: plm_core::time::Duration = 10_000;
 
 /// How late a USB-UART adapter behind WebSerial may deliver bytes: an
 /// FTDI chip holds received bytes up to its latency timer (16 ms by
-/// default), and the browser queues reads and writes behind it. The host
-/// waits this much longer for the modem (T_POLL, T_ACK, T_IC between
-/// received bytes); the ST7570's T_POLL of 20 ms (ST7570 UM Table 14) is
-/// otherwise shorter than one held packet.
-pub const LATENCY: plm_core::time::Duration = 20_000;
+/// default), and the browser queues reads, writes and signal changes
+/// behind it (each a USB transfer; through the e2e suite's scripted port
+/// a T_REQ-to-status round trip took up to about 40 ms on a busy
+/// machine). The host waits this much longer for the modem (T_POLL,
+/// T_ACK, T_IC between received bytes); the ST7570's T_POLL of 20 ms
+/// (ST7570 UM Table 14) is otherwise shorter than one held packet. Only a
+/// slower retry is lost when the modem really is silent.
+pub const LATENCY: plm_core::time::Duration = 50_000;
 
 /// What the output queue carries out, in order.
 enum Op {
