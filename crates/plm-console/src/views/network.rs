@@ -80,9 +80,15 @@ fn history(id: &'static str, list: impl Fn() -> VecDeque<Event> + Send + 'static
 fn StatusCard() -> impl IntoView {
     let c = use_console();
     let status = move || c.modem.network.with(|n| n.status);
+    // The modem sends a status message only when asked to take a frame
+    // (5.2.2): any request brings a fresh one.
+    let ask = move || c.read_mib(plm_core::st7570::mib::index::PLC_CONFIGURATION, |_| {});
     view! {
         <article class="card" id="net-status">
             <h3>"Modem status"</h3>
+            <div class="buttons">
+                {button("net-status-ask", "Ask now", "The modem sends its status message when the host asks to send (T_REQ): this reads 00A1h", ask)}
+            </div>
             {move || match status() {
                 None => view! { <p class="muted">"No status message yet (one comes with every request)."</p> }.into_any(),
                 Some((at, s)) => {
