@@ -427,6 +427,59 @@ mod tests {
         assert!(log.heard.is_empty(), "no MAC header in that P_SDU");
     }
 
+    /// Runs `s` for `ms` of the page's clock, feeding `log` as the
+    /// console's stores do.
+    fn drive(s: &mut crate::session::Session, log: &mut NetworkLog, page: &mut f64, ms: u32) {
+        use crate::session::{Budget, Note};
+        for _ in 0..ms / 4 {
+            *page += 4_000.0;
+            let t = s.tick(*page, Budget::UNLIMITED);
+            for n in t.notes {
+                match n {
+                    Note::Status { at, message } => log.on_status(at, message.data()),
+                    Note::Unsolicited { at, frame, .. } => log.on_indication(at, &frame),
+                    _ => {}
+                }
+            }
+            for (r, o) in t.replies {
+                r(o);
+            }
+        }
+    }
+
+    /// The console's simulated network with its modem a PHY Monitor: one
+    /// SPY indication per slot (searching, no Client on the line) makes
+    /// the timeline.
+    #[test]
+    fn a_monitor_s_spy_indications_make_the_timeline() {
+        use crate::session::Session;
+        use crate::transport::sfsk::SfskTransport;
+        use plm_core::link::Dialect;
+        use plm_core::st7570::mib::{index, object, PlcConfiguration};
+        let mut s = Session::new(
+            Some(Box::new(SfskTransport::new(4, 57_600, 7))),
+            Dialect::St7570,
+        );
+        let (mut log, mut page) = (NetworkLog::default(), 1_000_000.0);
+        let mut plc = PlcConfiguration::decode(object(index::PLC_CONFIGURATION).unwrap().default);
+        (plc.operating_mode, plc.access_layer_mode) = (3, 1);
+        s.request(
+            s.chip().mib_write(index::PLC_CONFIGURATION, &plc.encode()),
+            Box::new(|_| {}),
+        );
+        // Read back, as the set-up card does: its status message is the
+        // Monitor's.
+        s.request(
+            s.chip().mib_read(index::PLC_CONFIGURATION),
+            Box::new(|_| {}),
+        );
+        drive(&mut s, &mut log, &mut page, 3_000);
+        assert_eq!(log.status.map(|(_, st)| st.mode), Some(3));
+        let kinds: Vec<SpyKind> = log.spy.iter().map(|(_, k, _)| *k).collect();
+        assert!(kinds.len() >= 8, "{kinds:?}");
+        assert!(kinds.iter().all(|k| *k == SpyKind::Search), "{kinds:?}");
+    }
+
     /// The simulated network of the console's ST7570 profile, driven
     /// through the session as the page drives it: a MAC Client asks
     /// Server 001h, which answers; cut off by noise it loses
@@ -446,22 +499,7 @@ mod tests {
         );
         let mut log = NetworkLog::default();
         let mut page = 1_000_000.0;
-        let mut run = |s: &mut Session, log: &mut NetworkLog, ms: u32| {
-            for _ in 0..ms / 4 {
-                page += 4_000.0;
-                let t = s.tick(page, Budget::UNLIMITED);
-                for n in t.notes {
-                    match n {
-                        Note::Status { at, message } => log.on_status(at, message.data()),
-                        Note::Unsolicited { at, frame, .. } => log.on_indication(at, &frame),
-                        _ => {}
-                    }
-                }
-                for (r, o) in t.replies {
-                    r(o);
-                }
-            }
-        };
+        let mut run = |s: &mut Session, log: &mut NetworkLog, ms: u32| drive(s, log, &mut page, ms);
         let sfsk = |s: &mut Session| {
             s.transport_mut()
                 .and_then(|t| t.sfsk())

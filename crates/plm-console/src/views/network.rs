@@ -328,8 +328,8 @@ fn SpyCard() -> impl IntoView {
     view! {
         // Only a Monitor has SPY indications (Table 15).
         <article class="card wide" id="net-spy" hidden=move || net.with(|n| n.spy.is_empty() && n.status.is_none_or(|(_, s)| s.mode != 3))>
-            <h3>"Monitor: SPY timeline"</h3>
-            <p class="muted">"One mark per SPY indication, oldest first (Monitor mode, 5.3.17-5.3.22): S subframe, · no subframe, ? searching, F synchronization found, A alarm, - no alarm. Hover for S/N."</p>
+            <h3>"PHY Monitor: SPY timeline"</h3>
+            <p class="muted">"One mark per SPY indication, oldest first (PHY Monitor, 5.3.17-5.3.22): S subframe, · no subframe, ? searching, F synchronization found, A alarm, - no alarm. Hover for S/N."</p>
             <div class="timeline" id="net-spy-timeline">{slots}</div>
         </article>
     }
