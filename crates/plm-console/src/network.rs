@@ -487,7 +487,7 @@ mod tests {
     /// and finds it again once reconnected.
     #[test]
     fn a_simulated_server_answers_loses_synchronization_and_finds_it_again() {
-        use crate::session::{Budget, Note, Outcome, Session};
+        use crate::session::{Outcome, Session};
         use crate::transport::sfsk::SfskTransport;
         use plm_core::link::Dialect;
         use plm_core::st7570::mib::{index, object, PlcConfiguration};
