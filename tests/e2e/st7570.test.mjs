@@ -42,6 +42,8 @@ test('the ST7570 is chosen in the connection bar, remembered, and configured as 
 
   const card = page.locator('#mib-00a1');
   const status = card.locator('[data-role=status]');
+  // Read all filled the card: it no longer says "not read yet".
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
   await card.locator('[data-action=read]').click();
   await status.filter({ hasText: 'read from the modem' }).waitFor();
   assert.equal(await card.locator('[name=access_layer_mode]').inputValue(), '1');
