@@ -41,8 +41,15 @@ const WARM_UP = 20;
 const BAUD = 57_600;
 /** UART 8N1: start bit, 8 data bits, stop bit (UM0932 2.1). */
 const BITS_PER_BYTE = 10;
-/** MIB object read: 0Ah, firmware version (UM0932 4.2.10). */
-const MIB_INDEX = 0x0a;
+/**
+ * The modems benchmarked, each through its profile and its own MIB read:
+ * the ST7580's 0Ah, firmware version (UM0932 4.2.10), and the ST7570's
+ * 00A1h, PLC configuration (ST7570 UM Table 137, there in either layer).
+ */
+const CHIPS = [
+  { name: 'ST7580', profile: 'st7580', index: 0x0a, digits: 2, request: 'MIB_ReadRequest', confirm: 'MIB_ReadConfirm', resets: true },
+  { name: 'ST7570', profile: 'st7570', index: 0x00a1, digits: 4, request: 'CMD_ReadDBRequest', confirm: 'CMD_ReadDBConfirm', resets: false },
+];
 /** Lamps of the simulated street whose Street view is timed. */
 const STREET_LAMPS = 500;
 /** How long its frames are recorded. */
@@ -77,7 +84,7 @@ async function sizes() {
  * console's traffic log: the modem's status message, the host's
  * MIB_ReadRequest, the modem's ACK, its MIB_ReadConfirm and the host's ACK.
  */
-async function exchange(page) {
+async function exchange(page, chip) {
   const rows = await page.$$eval('#traffic-table tbody tr', (trs) =>
     trs.slice(-40).map((tr) => ({
       title: tr.querySelector('td.title')?.textContent ?? '',
@@ -86,8 +93,8 @@ async function exchange(page) {
         .length,
     })),
   );
-  const confirm = rows.findLastIndex((r) => r.title === 'MIB_ReadConfirm');
-  const request = rows.findLastIndex((r, i) => i < confirm && r.title === 'MIB_ReadRequest');
+  const confirm = rows.findLastIndex((r) => r.title === chip.confirm);
+  const request = rows.findLastIndex((r, i) => i < confirm && r.title === chip.request);
   const status = rows.findLastIndex((r, i) => i < request && r.way.includes('kind-status'));
   const ack = rows.findIndex((r, i) => i > confirm && r.way.includes('from-host kind-ack'));
   if ([confirm, request, status, ack].some((i) => i < 0)) {
@@ -255,52 +262,84 @@ async function streetFrames(browser, base) {
   return { rows, progress, n: frames.length, p50: at(50), p99: at(99), max: frames[frames.length - 1] };
 }
 
-async function main() {
-  const { server, base } = await serveDist();
-  const browser = await launchChromium();
-  const loadBefore = os.loadavg();
-  try {
-    const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
-    const errors = pageErrors(page);
-
-    await page.goto(base + '?profile=st7580#diagnostics');
-    await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
-    await page.waitForFunction(() => window.plmBench !== undefined);
-    // The simulated modem has booted once its BIO_ResetIndication is in.
+/**
+ * ACK latency and MIB-read rates of one chip's simulated modem, driven
+ * through `window.plmBench` on a page of its profile.
+ */
+async function modemBench(browser, base, chip) {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  const errors = pageErrors(page);
+  await page.goto(base + `?profile=${chip.profile}#diagnostics`);
+  await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+  await page.waitForFunction(() => window.plmBench !== undefined);
+  // The simulated ST7580 has booted once its BIO_ResetIndication is in;
+  // the ST7570 sends nothing at power-on.
+  if (chip.resets) {
     await page.waitForFunction(() => window.plmBench.ackLatency().count > 0, null, {
       timeout: 15_000,
     });
-    const baud = await page.evaluate((b) => window.plmBench.setBaud(b), BAUD);
-    if (baud !== BAUD) throw new Error(`the console would not take ${BAUD} baud (it has ${baud})`);
+  }
+  const baud = await page.evaluate((b) => window.plmBench.setBaud(b), BAUD);
+  if (baud !== BAUD) throw new Error(`the console would not take ${BAUD} baud (it has ${baud})`);
+  const reads = (n, chained) =>
+    page.evaluate(([n, i, c]) => window.plmBench.mibReads(n, i, c), [n, chip.index, chained]);
+  const checked = (r, what) => {
+    if (r.failed > 0) throw new Error(`${chip.name} ${what}: ${r.failed} of ${r.reads} failed: ${r.firstError}`);
+    return r;
+  };
+  checked(await reads(WARM_UP, false), 'warm-up');
+  const queued = checked(await reads(READS, false), 'queued reads');
+  const chained = checked(await reads(READS, true), 'chained reads');
+  const ack = await page.evaluate(() => window.plmBench.ackLatency());
+  const noise = await wakeNoise(page);
+  const causes = process.env.PLM_BENCH_CAUSES === '1' ? await lateCauses(browser, page, reads) : [];
+  const load = os.loadavg();
+  await page.screenshot({ path: path.join(artifacts, `bench-${chip.profile}.png`) });
+  // The exchange as the Traffic tab shows it (a hidden table is left as it was).
+  await page.click('#tab-traffic');
+  await page.waitForFunction(
+    (name) => [...document.querySelectorAll('#traffic-table td.title')].some((td) => td.textContent === name),
+    chip.confirm,
+  );
+  const parts = await exchange(page, chip);
+  await page.close();
+  if (errors.length) throw new Error(`errors in the ${chip.name} page: ${errors.join('; ')}`);
+  return { chip, queued, chained, ack, noise, causes, load, parts };
+}
 
-    const reads = (n, chained) =>
-      page.evaluate(([n, i, c]) => window.plmBench.mibReads(n, i, c), [n, MIB_INDEX, chained]);
-    const checked = (r, what) => {
-      if (r.failed > 0) throw new Error(`${what}: ${r.failed} of ${r.reads} failed: ${r.firstError}`);
-      return r;
-    };
-    checked(await reads(WARM_UP, false), 'warm-up');
-    const queued = checked(await reads(READS, false), 'queued reads');
-    const chained = checked(await reads(READS, true), 'chained reads');
-    const ack = await page.evaluate(() => window.plmBench.ackLatency());
-    const noise = await wakeNoise(page);
-    const causes = process.env.PLM_BENCH_CAUSES === '1' ? await lateCauses(browser, page, reads) : [];
-    const loadAfter = os.loadavg();
-    await page.screenshot({ path: path.join(artifacts, 'bench-diagnostics.png') });
-    // The exchange as the Traffic tab shows it (a hidden table is left as it was).
-    await page.click('#tab-traffic');
-    await page.waitForFunction(() =>
-      [...document.querySelectorAll('#traffic-table td.title')].some((td) => td.textContent === 'MIB_ReadConfirm'),
-    );
-    const parts = await exchange(page);
-    if (errors.length) throw new Error(`errors in the page: ${errors.join('; ')}`);
+/** The report's lines for one chip. */
+function modemLines({ chip, queued, chained, ack, noise, causes, load, parts }, spread) {
+  const bytes = parts.reduce((n, p) => n + p.bytes, 0);
+  const wireMs = (bytes * BITS_PER_BYTE * 1000) / BAUD;
+  const limit = 1000 / wireMs;
+  const rate = (r) => (r.reads * 1000) / r.elapsedMs;
+  const pct = (x) => `${((100 * x) / limit).toFixed(0)}% of the limit`;
+  const index = chip.index.toString(16).padStart(chip.digits, '0').toUpperCase();
+  return [
+    '',
+    `${chip.name}, simulated:`,
+    `ACK latency, last byte of a modem frame to the host's ACK (${ack.count} frames; T_ACK ${ack.tAck} ms):`,
+    `  page's clock   ${spread(ack.page)}   (includes how late the page woke, and stalls)`,
+    `  virtual link   ${spread(ack.link)}   (what the simulated modem saw: its time waits for the page)`,
+    `  machine noise  ${spread(noise)}   (a bare wake loop as the console's, ${noise.n} wakes right after, same page)`,
+    `  load average ${load.map((x) => x.toFixed(2)).join(' ')} (${os.cpus().length} cores)`,
+    ...causes,
+    `MIB reads (${chip.request} ${index}h, ${queued.dataLen}-byte value), ${READS} each:`,
+    `  queued   ${READS} in ${msText(queued.elapsedMs)} = ${rate(queued).toFixed(0)} /s (${pct(rate(queued))}; the session sends the next on each answer)`,
+    `  chained  ${READS} in ${msText(chained.elapsedMs)} = ${rate(chained).toFixed(0)} /s (${pct(rate(chained))}; the next sent from the reply, as a view does)`,
+    `  wire-time limit: ${parts.map((p) => `${p.name} ${p.bytes}`).join(' + ')} = ${bytes} bytes`,
+    `    x ${BITS_PER_BYTE} bits / ${BAUD} baud = ${wireMs.toFixed(2)} ms -> ${limit.toFixed(0)} round trips /s`,
+  ];
+}
+
+async function main() {
+  const { server, base } = await serveDist();
+  const browser = await launchChromium();
+  try {
+    const modems = [];
+    for (const chip of CHIPS) modems.push(await modemBench(browser, base, chip));
     const street = process.env.PLM_BENCH_STREET === '0' ? null : await streetFrames(browser, base);
 
-    const bytes = parts.reduce((n, p) => n + p.bytes, 0);
-    const wireMs = (bytes * BITS_PER_BYTE * 1000) / BAUD;
-    const limit = 1000 / wireMs;
-    const rate = (r) => (r.reads * 1000) / r.elapsedMs;
-    const pct = (x) => `${((100 * x) / limit).toFixed(0)}% of the limit`;
     const dsizes = await sizes();
     const total = dsizes.reduce((a, r) => ({ raw: a.raw + r.raw, gz: a.gz + r.gz }), {
       raw: 0,
@@ -311,20 +350,8 @@ async function main() {
 
     const out = [
       '',
-      `PLM Console, Chromium ${browser.version()}, simulated ST7580 at ${BAUD} baud`,
-      '',
-      `ACK latency, last byte of a modem frame to the host's ACK (${ack.count} frames; T_ACK ${ack.tAck} ms):`,
-      `  page's clock   ${spread(ack.page)}   (includes how late the page woke, and stalls)`,
-      `  virtual link   ${spread(ack.link)}   (what the simulated modem saw: its time waits for the page)`,
-      `  machine noise  ${spread(noise)}   (a bare wake loop as the console's, ${noise.n} wakes right after, same page)`,
-      `  load average ${loadBefore.map((x) => x.toFixed(2)).join(' ')} before, ${loadAfter.map((x) => x.toFixed(2)).join(' ')} after (${os.cpus().length} cores)`,
-      ...causes,
-      '',
-      `MIB reads (MIB_ReadRequest ${MIB_INDEX.toString(16).padStart(2, '0').toUpperCase()}h, ${queued.dataLen}-byte value), ${READS} each:`,
-      `  queued   ${READS} in ${msText(queued.elapsedMs)} = ${rate(queued).toFixed(0)} /s (${pct(rate(queued))}; the session sends the next on each answer)`,
-      `  chained  ${READS} in ${msText(chained.elapsedMs)} = ${rate(chained).toFixed(0)} /s (${pct(rate(chained))}; the next sent from the reply, as a view does)`,
-      `  wire-time limit: ${parts.map((p) => `${p.name} ${p.bytes}`).join(' + ')} = ${bytes} bytes`,
-      `    x ${BITS_PER_BYTE} bits / ${BAUD} baud = ${wireMs.toFixed(2)} ms -> ${limit.toFixed(0)} round trips /s`,
+      `PLM Console, Chromium ${browser.version()}, simulated modems at ${BAUD} baud`,
+      ...modems.flatMap((m) => modemLines(m, spread)),
       '',
       ...(street
         ? [

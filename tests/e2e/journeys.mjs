@@ -70,13 +70,16 @@ export async function phyRoundTrip(page, shotName) {
  * nothing is sent (no MIB_WriteRequest in the log; the caller may check
  * the wire too).
  */
-export async function refusedFrequency(page, shotName) {
+export async function refusedFrequency(page, shotName, chip = ST7580_F) {
+  await tab(page, 'traffic');
+  const writes = async () => (await titles(page)).filter((t) => t === chip.write).length;
+  const before = await writes();
   await tab(page, 'modem');
-  const card = page.locator('#mib-01');
-  await card.locator('input[name=high_frequency]').fill('200000');
+  const card = page.locator(chip.card);
+  await card.locator(`input[name=${chip.field}]`).fill('200000');
   await card.locator('[data-action=write]').click();
-  const reason = card.locator('tr[data-field=high_frequency] [data-role=problem]');
-  await reason.filter({ hasText: '200000 is out of range 3000..=148500 Hz' }).waitFor();
+  const reason = card.locator(`tr[data-field=${chip.field}] [data-role=problem]`);
+  await reason.filter({ hasText: `200000 is out of range ${chip.range} Hz` }).waitFor();
   assert.ok(await reason.isVisible());
   assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
   await shot(page, shotName);
@@ -84,9 +87,13 @@ export async function refusedFrequency(page, shotName) {
   await page.waitForTimeout(300);
   await tab(page, 'traffic');
   const all = await titles(page);
-  assert.ok(all.length > 0, 'the log has the reset indication');
-  assert.ok(!all.includes('MIB_WriteRequest'), all.join(', '));
+  assert.ok(all.length > 0 || !chip.reset, 'the log has the reset indication');
+  assert.equal(await writes(), before, `no ${chip.write} sent: ${all.join(', ')}`);
 }
+
+/** The frequency field of each chip's PHY configuration object. */
+export const ST7580_F = { card: '#mib-01', field: 'high_frequency', range: '3000..=148500', write: 'MIB_WriteRequest', reset: true };
+export const ST7570_F = { card: '#mib-00a1', field: 'f0', range: '3000..=140000', write: 'CMD_WriteDBRequest', reset: false };
 
 /**
  * Traffic view: export the log to JSON Lines, clear, import it again and
@@ -116,4 +123,37 @@ export async function exportImport(page, fileName, shotName) {
   assert.deepEqual(await titles(page), before);
   if (shotName) await shot(page, shotName);
   return entries;
+}
+
+/** ST7570: the Modem view's set-up card makes the modem a MAC Client. */
+export async function macClient(page) {
+  await tab(page, 'modem');
+  await page.locator('#setup-role').selectOption('0');
+  await page.click('#setup-write');
+  const result = page.locator('#setup-result');
+  await result.filter({ hasText: /read back|not written|failed/ }).waitFor({ timeout: 10_000 });
+  assert.equal(await result.textContent(), 'MAC Client (initiator): 00A1h written, read back: the modem has it');
+}
+
+/**
+ * ST7570, MAC Client: the Data view sends "?" to Server 001h, the modem
+ * confirms LM_OK, and the Server's answer (its address and phase) is
+ * among the received frames.
+ */
+export async function macAsk(page) {
+  await tab(page, 'data');
+  await page.fill('#sfsk-da', '001');
+  await page.fill('#sfsk-payload', '?');
+  const before = await page.locator('#sfsk-received-table tbody tr').count();
+  await page.click('#sfsk-send-btn');
+  const result = page.locator('#sfsk-result');
+  await result.filter({ hasText: /^(?!sending)./ }).waitFor({ timeout: 25_000 });
+  assert.equal(await result.textContent(), 'CMD_DataConfirm: LM_OK');
+  const answers = page.locator('#sfsk-received-table tbody tr', { hasText: '001h → ' }).filter({ hasText: '"!001 phase' });
+  await page.waitForFunction(
+    (n) => document.querySelectorAll('#sfsk-received-table tbody tr').length > n,
+    before,
+    { timeout: 10_000 },
+  );
+  await answers.first().waitFor();
 }

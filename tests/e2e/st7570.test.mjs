@@ -6,7 +6,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot, tab, titles } from './journeys.mjs';
+import { macAsk, macClient, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
 
 let server;
 let base;
@@ -42,6 +42,8 @@ test('the ST7570 is chosen in the connection bar, remembered, and configured as 
 
   const card = page.locator('#mib-00a1');
   const status = card.locator('[data-role=status]');
+  // Read all filled the card: it no longer says "not read yet".
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
   await card.locator('[data-action=read]').click();
   await status.filter({ hasText: 'read from the modem' }).waitFor();
   assert.equal(await card.locator('[name=access_layer_mode]').inputValue(), '1');
@@ -68,15 +70,39 @@ test('the ST7570 is chosen in the connection bar, remembered, and configured as 
 
 test('an out-of-range ST7570 value is refused in the form with the reason, and nothing is sent', async (t) => {
   const page = await open(t, '?profile=st7570');
-  const card = page.locator('#mib-00a1');
-  await card.locator('input[name=f0]').fill('200000');
-  await card.locator('[data-action=write]').click();
-  const reason = card.locator('tr[data-field=f0] [data-role=problem]');
-  await reason.filter({ hasText: '200000 is out of range 3000..=140000 Hz' }).waitFor();
-  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
-  await shot(page, 'st7570-refused');
-  await page.waitForTimeout(300);
-  await tab(page, 'traffic');
-  const all = await titles(page);
-  assert.ok(!all.includes('CMD_WriteDBRequest'), all.join(', '));
+  await refusedFrequency(page, 'st7570-refused', ST7570_F);
+});
+
+test('a MAC Client asks a Server and sees its answer, the synchronization of that Server lost and found, and an alarm sent', async (t) => {
+  const page = await open(t, '?profile=st7570');
+  await macClient(page);
+
+  // MAC timeouts 60 times as fast: 0003h's 40 s become 0.7 s.
+  await tab(page, 'network');
+  await page.locator('#net-sim-scale').selectOption('60');
+  await page.locator('#net-status', { hasText: 'Client' }).waitFor({ timeout: 10_000 });
+
+  await macAsk(page);
+  await shot(page, 'st7570-data');
+
+  await tab(page, 'network');
+  const server = page.locator('#sim-server-1');
+  await server.filter({ hasText: 'CONFIRMED' }).waitFor({ timeout: 10_000 });
+  await page.locator('#net-nodes-table tr[data-key="001h"]').waitFor();
+  // No frame for 0003h: lost, cause 2.
+  await server.filter({ hasText: 'LOST, cause 2: Timeout frame not OK expired' }).waitFor({ timeout: 10_000 });
+  assert.match(await server.locator('td.sync').textContent(), /^not synchronized$/);
+  // Cut off, it hears nothing; reconnected, the next frame finds it again.
+  await server.locator('button.cut').click();
+  await server.locator('button.cut', { hasText: 'Reconnect' }).click();
+  await server.locator('button.cut', { hasText: 'Cut off' }).waitFor();
+  // Back to the manual's timeouts, so that it stays synchronized a while.
+  await page.locator('#net-sim-scale').selectOption('1');
+  await macAsk(page);
+  await tab(page, 'network');
+  await server.locator('td.fields').filter({ hasText: /^\d+\.\d+ s CONFIRMED/ }).waitFor({ timeout: 10_000 });
+
+  await page.click('#net-alarm');
+  await page.locator('#net-alarm-history', { hasText: 'alarm sent: LP_OK' }).waitFor({ timeout: 10_000 });
+  await shot(page, 'st7570-network');
 });

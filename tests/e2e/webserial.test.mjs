@@ -20,7 +20,7 @@ import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { launchChromium, serveDist, pageErrors, watchedPage } from './harness.mjs';
-import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
+import { exportImport, macAsk, macClient, phyRoundTrip, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -467,6 +467,23 @@ test('WebSerial: the traffic log exports to JSON Lines and imports again', async
   await ping(page);
   const entries = await exportImport(page, 'webserial-traffic.jsonl');
   assert.ok(entries.some((e) => e.command === 'PingConfirm' && e.from === 'modem'));
+});
+
+test('WebSerial: an ST7570 on the port (plm sim --chip st7570) is made a MAC Client, a Server answers its frame, and a wrong f0 is refused', async (t) => {
+  const { page, wire } = await open(t, { world: ['--chip', 'st7570', '--nodes', '4'], profile: 'st7570' });
+  // The ST7570 sends no frame at power-on (its status message says RESET).
+  await connectSerial(page, { reset: false });
+  assert.match(await page.textContent('#conn-chip'), /ST7570/);
+  await macClient(page);
+  await macAsk(page);
+  await tab(page, 'network');
+  await page.locator('#net-status', { hasText: 'Client' }).waitFor();
+  await page.locator('#net-nodes-table tr[data-key="001h"]').waitFor();
+  // No simulated line in the page: a real network shows what the modem hears.
+  assert.equal(await page.locator('#net-sim').isVisible(), false);
+  assert.ok(wireLog(wire).some((e) => e.rts === true), 'T_REQ driven by RTS');
+  await shot(page, 'webserial-st7570-network');
+  await refusedFrequency(page, 'webserial-st7570-refused', ST7570_F);
 });
 
 test('a browser without WebSerial is told so plainly, and the simulated modem still works', async (t) => {

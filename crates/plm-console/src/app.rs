@@ -7,6 +7,8 @@ use crate::views::connection_bar::ConnectionBar;
 use crate::views::data::DataView;
 use crate::views::diagnostics::DiagnosticsView;
 use crate::views::modem::ModemView;
+use crate::views::network::NetworkView;
+use crate::views::sfsk_data::SfskDataView;
 use crate::views::simulator::SimulatorView;
 use crate::views::street::StreetView;
 use crate::views::traffic::TrafficView;
@@ -28,19 +30,22 @@ pub enum Tab {
     Data,
     /// Ping, status, reset, counters.
     Diagnostics,
+    /// An ST7570's S-FSK network.
+    Network,
     /// The simulated world.
     Simulator,
 }
 
 impl Tab {
     /// Every tab.
-    pub const ALL: [Tab; 7] = [
+    pub const ALL: [Tab; 8] = [
         Tab::Street,
         Tab::Update,
         Tab::Traffic,
         Tab::Modem,
         Tab::Data,
         Tab::Diagnostics,
+        Tab::Network,
         Tab::Simulator,
     ];
 
@@ -53,6 +58,7 @@ impl Tab {
             Tab::Modem => "Modem",
             Tab::Data => "Data",
             Tab::Diagnostics => "Diagnostics",
+            Tab::Network => "Network",
             Tab::Simulator => "Simulator",
         }
     }
@@ -66,6 +72,7 @@ impl Tab {
             Tab::Modem => "modem",
             Tab::Data => "data",
             Tab::Diagnostics => "diagnostics",
+            Tab::Network => "network",
             Tab::Simulator => "simulator",
         }
     }
@@ -172,7 +179,7 @@ pub fn App() -> impl IntoView {
                     <ModemView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Data>
-                    <St7580Only what="data services (PHY, DL, SS)">
+                    <St7580Only what="data services (PHY, DL, SS)" st7570=|| view! { <SfskDataView/> }.into_any()>
                         <DataView tab=tab/>
                     </St7580Only>
                 </Panel>
@@ -180,6 +187,9 @@ pub fn App() -> impl IntoView {
                     <St7580Only what="diagnostics (ping, reset, counters, firmware)">
                         <DiagnosticsView/>
                     </St7580Only>
+                </Panel>
+                <Panel tab=tab which=Tab::Network>
+                    <NetworkView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Simulator>
                     <SimulatorView/>
@@ -207,20 +217,28 @@ fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
 }
 
 /// A view of what only the ST7580 has: shown unless the ST7570 profile
-/// is chosen, which says where its counterparts are meanwhile.
+/// is chosen, when the ST7570's counterpart (`st7570`) shows instead, or
+/// where to find it.
 #[component]
-fn St7580Only(what: &'static str, children: ChildrenFn) -> impl IntoView {
+fn St7580Only(
+    what: &'static str,
+    #[prop(optional)] st7570: Option<fn() -> AnyView>,
+    children: ChildrenFn,
+) -> impl IntoView {
     let console = use_console();
-    let st7570 = move || console.profile.get() == Profile::St7570;
+    let chosen = move || console.profile.get() == Profile::St7570;
     view! {
         <Show
-            when=move || !st7570()
-            fallback=move || view! {
-                <article class="card">
-                    <p class="muted">
-                        {format!("These ST7580 {what} do not apply to the ST7570. Its MIB is in the Modem view and its frames, decoded in its access layer, in Traffic.")}
-                    </p>
-                </article>
+            when=move || !chosen()
+            fallback=move || match st7570 {
+                Some(view) => view(),
+                None => view! {
+                    <article class="card">
+                        <p class="muted">
+                            {format!("These ST7580 {what} do not apply to the ST7570. Its MIB is in the Modem view, its network in Network and its frames, decoded in its access layer, in Traffic.")}
+                        </p>
+                    </article>
+                }.into_any(),
             }
         >
             {children()}

@@ -6,8 +6,8 @@
 //!
 //! - `plmBench.setBaud(baud)`: as the connection bar's baud select (UM0932
 //!   Table 5 rates only); returns the baud rate in use.
-//! - `plmBench.mibReads(n, index, chained)`: `n` MIB_ReadRequests of
-//!   `index`, all queued at once (the session sends each as soon as the
+//! - `plmBench.mibReads(n, index, chained)`: `n` reads of MIB object
+//!   `index` (the profile's chip: `Chip::mib_read`), all queued at once (the session sends each as soon as the
 //!   previous one is answered) or, `chained`, each sent from the previous
 //!   one's reply, as a view would. A Promise of `{reads, failed,
 //!   firstError, dataLen, elapsedMs}` on the page's clock.
@@ -18,10 +18,9 @@
 //!   (`performance.now()`) when the tick that wrote the ACK began.
 
 use crate::session::{Outcome, Spread};
-use crate::stores::{page_now_us, refusal, unexpected, Console};
+use crate::stores::{page_now_us, Console};
 use js_sys::{Function, Object, Promise, Reflect};
 use leptos::prelude::GetUntracked;
-use plm_core::st7580::Command;
 use plm_core::time::Duration;
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -39,8 +38,8 @@ pub fn install(c: Console) {
         }
         c.conn.baud.get_untracked()
     });
-    let mib_reads = Closure::<dyn Fn(u32, u8, bool) -> Promise>::new(
-        move |n: u32, index: u8, chained: bool| mib_reads(c, n, index, chained),
+    let mib_reads = Closure::<dyn Fn(u32, u16, bool) -> Promise>::new(
+        move |n: u32, index: u16, chained: bool| mib_reads(c, n, index, chained),
     );
     let ack_latency = Closure::<dyn Fn() -> JsValue>::new(move || ack_latency(c));
     let ack_samples = Closure::<dyn Fn() -> JsValue>::new(move || ack_samples(c));
@@ -111,7 +110,7 @@ struct Run {
     resolve: Function,
 }
 
-fn mib_reads(c: Console, n: u32, index: u8, chained: bool) -> Promise {
+fn mib_reads(c: Console, n: u32, index: u16, chained: bool) -> Promise {
     Promise::new(&mut |resolve, _reject| {
         let run = Rc::new(RefCell::new(Run {
             n,
@@ -134,22 +133,25 @@ fn mib_reads(c: Console, n: u32, index: u8, chained: bool) -> Promise {
     })
 }
 
-fn read(c: Console, run: Rc<RefCell<Run>>, index: u8, chained: bool) {
-    c.request(Command::MibReadRequest { index }, move |o| {
+fn read(c: Console, run: Rc<RefCell<Run>>, index: u16, chained: bool) {
+    // The chip's own MIB read (the profile's), its answer read by the
+    // chip's description: the same bench for both chips.
+    let frame = c.with_chip(|ch| ch.mib_read(index));
+    c.request_frame(frame, move |o| {
         let more = {
             let mut r = run.borrow_mut();
             r.done += 1;
-            match o {
+            let value = match o {
                 Outcome::Answer {
-                    command: Command::MibReadConfirm { data },
+                    command: Some(answer),
                     ..
-                } => r.data_len = data.len(),
-                Outcome::Answer { command, .. } => {
-                    r.failed += 1;
-                    let why = refusal(&command).unwrap_or_else(|| unexpected(&command));
-                    r.first_error.get_or_insert(why);
-                }
-                Outcome::Failed(why) => {
+                } => c.with_chip(|ch| ch.verdict(&answer)),
+                Outcome::Answer { command: None, .. } => Err("no answer".into()),
+                Outcome::Failed(why) => Err(why),
+            };
+            match value {
+                Ok(data) => r.data_len = data.len(),
+                Err(why) => {
                     r.failed += 1;
                     r.first_error.get_or_insert(why);
                 }

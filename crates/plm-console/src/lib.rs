@@ -8,6 +8,7 @@
 //!   of lamps it learns about.
 //! - [`traffic`]: the inspector's bounded, filterable, exportable log.
 //! - [`mibform`]: MIB forms read from plm-core's declarative description.
+//! - [`network`]: what an ST7570 tells of its S-FSK network.
 //! - [`app`], [`stores`], [`views`]: the Leptos application.
 //! - [`bench_hook`]: `window.plmBench`, for `cargo xtask bench`.
 //! - [`wake`]: when the page runs the sessions (bytes, deadlines, the
@@ -20,6 +21,7 @@ static ALLOCATOR: talc::wasm::WasmDynamicTalc = talc::wasm::new_wasm_dynamic_all
 
 pub mod fleet;
 pub mod mibform;
+pub mod network;
 pub mod profile;
 pub mod session;
 pub mod storage;

@@ -30,6 +30,11 @@ impl Texts {
         }
     }
 
+    /// Every field's text, in the order set.
+    pub fn iter(&self) -> impl Iterator<Item = &(&'static str, String)> {
+        self.0.iter()
+    }
+
     /// Whether field `name` has a text.
     pub fn contains_key(&self, name: &str) -> bool {
         self.get(name).is_some()

@@ -25,7 +25,7 @@ use crate::transport::{LinkState, Transport};
 use plm_core::chip::{self, Chip};
 use plm_core::decode::Decoded;
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
-use plm_core::link::{Dialect, Element, LocalFrame, Source, Timeouts};
+use plm_core::link::{Dialect, Element, LocalFrame, Source, StatusMessage, Timeouts};
 use plm_core::time::{Duration, Instant, MS};
 use std::collections::VecDeque;
 
@@ -211,12 +211,12 @@ pub enum Note {
         /// The element, named as `plm decode` names it.
         decoded: Box<Decoded>,
     },
-    /// A status message arrived: the byte after `?`.
+    /// A status message arrived.
     Status {
         /// When.
         at: Instant,
-        /// The status byte (UM0932 Table 8).
-        byte: u8,
+        /// The bytes after `?` (UM0932 Table 8, ST7570 UM Table 11).
+        message: StatusMessage,
     },
     /// T_REQ changed; `true` is asserted (low).
     TReq(bool),
@@ -403,6 +403,9 @@ pub struct Session {
     unanswered: u8,
     /// When notes were last handed out, µs of the page's clock.
     shown: f64,
+    /// The modem's timeouts (MIB 09h, 000Bh, the chip's at reset); the
+    /// host engine waits them plus the transport's latency.
+    timeouts: Timeouts,
     out: Tick,
 }
 
@@ -410,7 +413,7 @@ impl Session {
     /// A session with a chip of `dialect` over `transport` (or none yet).
     pub fn new(transport: Option<Box<dyn Transport>>, dialect: Dialect) -> Self {
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
-        Session {
+        let mut s = Session {
             transport,
             host: HostEngine::new(dialect, HostConfig::at_reset(dialect, baud)),
             chip: chip::for_dialect(dialect),
@@ -424,7 +427,33 @@ impl Session {
             ack_times: AckTimes::default(),
             unanswered: 0,
             shown: 0.0,
+            timeouts: Timeouts::at_reset(dialect, baud),
             out: Tick::default(),
+        };
+        s.configure();
+        s
+    }
+
+    /// Gives the host engine the modem's timeouts, each of its waits for
+    /// the modem (T_POLL, T_ACK, and T_IC between received bytes)
+    /// lengthened by the transport's latency ([`Transport::latency`]: a
+    /// USB adapter holds received bytes and queues the host's), and tells
+    /// the transport the modem's T_IC.
+    fn configure(&mut self) {
+        let t = self.timeouts;
+        let slack = self.transport.as_ref().map_or(0, |t| t.latency());
+        let config = HostConfig {
+            timeouts: Timeouts {
+                t_poll: t.t_poll + slack,
+                t_ack: t.t_ack + slack,
+                t_ic: t.t_ic + slack,
+                ..t
+            },
+            ..self.host.config()
+        };
+        self.host.set_config(config);
+        if let Some(tr) = self.transport.as_mut() {
+            tr.set_byte_gap_limit(t.t_ic);
         }
     }
 
@@ -469,13 +498,13 @@ impl Session {
         self.host = HostEngine::new(dialect, HostConfig::at_reset(dialect, baud));
         self.chip = chip::for_dialect(dialect);
         self.transport = transport;
+        self.timeouts = Timeouts::at_reset(dialect, baud);
+        self.configure();
         self.pacer = Pacer::default();
         self.duplicate_of = None;
         self.ack_times = AckTimes::default();
         self.out.notes.push(Note::TReq(false));
-        self.out
-            .notes
-            .push(Note::Timeouts(self.host.config().timeouts));
+        self.out.notes.push(Note::Timeouts(self.timeouts));
     }
 
     /// Changes the UART baud rate of the transport and the engine.
@@ -492,7 +521,7 @@ impl Session {
 
     /// The host-interface timeouts in use.
     pub fn timeouts(&self) -> Timeouts {
-        self.host.config().timeouts
+        self.timeouts
     }
 
     /// How quickly the host has ACKed the modem's frames since connecting.
@@ -726,11 +755,9 @@ impl Session {
     fn on_event(&mut self, now: Instant, e: Event) {
         match e {
             Event::Received(el) => {
-                if let Element::Status(s) = &el {
-                    if let Some(&byte) = s.data().first() {
-                        let at = self.log_time(now);
-                        self.out.notes.push(Note::Status { at, byte });
-                    }
+                if let Element::Status(message) = el {
+                    let at = self.log_time(now);
+                    self.out.notes.push(Note::Status { at, message });
                 }
                 self.traffic(now, &el, Source::Modem);
             }
@@ -854,16 +881,14 @@ impl Session {
     }
 
     fn set_timeouts(&mut self, timeouts: Timeouts) {
-        let config = HostConfig {
-            timeouts,
-            ..self.host.config()
-        };
-        self.host.set_config(config);
+        self.timeouts = timeouts;
+        self.configure();
         self.out.notes.push(Note::Timeouts(timeouts));
     }
 
-    /// A time on the transport's clock as the notes give it.
-    fn log_time(&self, t: Instant) -> Instant {
+    /// A time on the transport's clock on the traffic log's (which goes
+    /// on across connections).
+    pub fn log_time(&self, t: Instant) -> Instant {
         (t as i64).saturating_add(self.log_offset).max(0) as Instant
     }
 

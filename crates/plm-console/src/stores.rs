@@ -87,6 +87,8 @@ pub struct ModemStore {
     pub last_reset: RwSignal<Option<(Instant, u8)>>,
     /// The value of each MIB object as last read or written.
     pub mib: RwSignal<crate::mibform::MibValues>,
+    /// What an ST7570 told of its S-FSK network (the Network view).
+    pub network: RwSignal<crate::network::NetworkLog>,
 }
 
 /// The Simulator view's state.
@@ -108,6 +110,8 @@ pub struct SimStore {
     /// How much faster than the page's clock a simulated street runs
     /// (`?speed=N`, demos and tests; 1 by default).
     pub speed: RwSignal<u32>,
+    /// The simulated ST7570 Servers, as the Network view shows them.
+    pub servers: RwSignal<Vec<crate::transport::sfsk::SimServer>>,
 }
 
 /// Lamps on the simulated street the page opens on.
@@ -244,6 +248,7 @@ pub fn provide_console() -> Console {
             status: RwSignal::new(None),
             last_reset: RwSignal::new(None),
             mib: RwSignal::new(Default::default()),
+            network: RwSignal::new(Default::default()),
         },
         sim: SimStore {
             nodes: RwSignal::new(1),
@@ -252,6 +257,7 @@ pub fn provide_console() -> Console {
             plugged: RwSignal::new(true),
             echoed: RwSignal::new(0),
             line_events: RwSignal::new(VecDeque::new()),
+            servers: RwSignal::new(Vec::new()),
             speed: RwSignal::new(1),
         },
         street: StreetStore {
@@ -364,6 +370,7 @@ impl Console {
         self.street.version.update(|v| *v += 1);
         self.modem.mib.set(Default::default());
         self.modem.status.set(None);
+        self.modem.network.update(|n| n.clear());
         self.conn.retries.set(0);
         self.conn.last_problem.set(None);
         self.conn.advice.set(None);
@@ -460,6 +467,13 @@ impl Console {
         });
     }
 
+    /// The transport's clock now (µs), as the traffic log counts it.
+    pub fn now(&self) -> Instant {
+        let session = self.session();
+        let s = session.borrow();
+        s.log_time(s.now())
+    }
+
     /// Reads from the chip's host interface description.
     pub fn with_chip<R>(&self, f: impl FnOnce(&dyn Chip) -> R) -> R {
         f(self.session().borrow().chip())
@@ -529,6 +543,17 @@ impl Console {
         self.with_active(|t, _| {
             if let Some(sim) = t.and_then(|t| t.simulator()) {
                 f(sim);
+            }
+        });
+        self.refresh();
+    }
+
+    /// Does something to the simulated S-FSK network, if that is what is
+    /// connected.
+    pub fn with_sfsk(&self, f: impl FnOnce(&mut crate::transport::sfsk::SfskTransport)) {
+        self.with_active(|t, _| {
+            if let Some(net) = t.and_then(|t| t.sfsk()) {
+                f(net);
             }
         });
         self.refresh();
@@ -609,11 +634,31 @@ impl Console {
     }
 
     fn refresh_sim(&self) {
-        let (events, echoed, plugged, state) =
-            self.with_active(|t, state| match t.and_then(|t| t.simulator()) {
-                Some(sim) => (sim.line_events(), sim.echoed(), sim.plugged(), Some(state)),
-                None => (Vec::new(), 0, true, None),
-            });
+        let (events, echoed, plugged, state, servers) = self.with_active(|t, state| {
+            let servers = |t: &mut dyn Transport| t.sfsk().map(|s| s.servers());
+            match t {
+                Some(t) => match t.simulator() {
+                    Some(sim) => (
+                        sim.line_events(),
+                        sim.echoed(),
+                        sim.plugged(),
+                        Some(state),
+                        None,
+                    ),
+                    None => (Vec::new(), 0, true, None, servers(t)),
+                },
+                None => (Vec::new(), 0, true, None, None),
+            }
+        });
+        let mut servers = servers.unwrap_or_default();
+        {
+            let session = self.session();
+            let s = session.borrow();
+            for (at, _) in servers.iter_mut().flat_map(|v| v.syncs.iter_mut()) {
+                *at = s.log_time(*at);
+            }
+        }
+        set_if_changed(self.sim.servers, servers);
         if let Some(state) = state {
             set_if_changed(self.conn.state, state);
         }
@@ -696,7 +741,13 @@ impl Console {
         for n in notes {
             match n {
                 Note::Traffic { at, decoded } => traffic.push((at, *decoded)),
-                Note::Status { at, byte } => status = Some((at, byte)),
+                Note::Status { at, message } => {
+                    let data = message.data();
+                    status = Some((at, data[0]));
+                    if data.len() == 3 {
+                        self.modem.network.update(|n| n.on_status(at, data));
+                    }
+                }
                 Note::TReq(level) => set_if_changed(self.conn.treq, level),
                 Note::Unsolicited {
                     at,
@@ -707,7 +758,11 @@ impl Console {
                     let cause = frame.data.first().copied().unwrap_or(0);
                     self.modem.last_reset.set(Some((at, cause)));
                 }
-                Note::Unsolicited { .. } => {}
+                Note::Unsolicited { at, frame, .. } => {
+                    if self.profile.get_untracked() == Profile::St7570 {
+                        self.modem.network.update(|n| n.on_indication(at, &frame));
+                    }
+                }
                 Note::Retry { cause, .. } => {
                     self.conn.retries.update(|r| *r += 1);
                     self.conn.last_problem.set(Some(cause));

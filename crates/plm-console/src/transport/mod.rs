@@ -12,7 +12,7 @@ pub mod sim;
 #[cfg(target_arch = "wasm32")]
 pub mod webserial;
 
-use plm_core::time::Instant;
+use plm_core::time::{Duration, Instant};
 use plm_sim::{Fault, LineConfig, LineEvent};
 
 /// Whether a transport can carry bytes now.
@@ -68,8 +68,25 @@ pub trait Transport {
     fn next_event(&self) -> Option<Instant> {
         None
     }
+    /// How late the transport may hand over the modem's bytes, or carry
+    /// out the host's, beyond their wire time (0 for a simulated modem):
+    /// the host's waits for the modem are lengthened by it.
+    fn latency(&self) -> Duration {
+        0
+    }
+    /// The modem's T_IC: the longest gap it allows between two bytes of
+    /// a frame (UM0932 3.2.6, ST7570 UM 5.2.2). A transport that cannot
+    /// time a T_REQ change between two writes that closely keeps a
+    /// frame's bytes together ([`webserial`]).
+    fn set_byte_gap_limit(&mut self, t_ic: Duration) {
+        let _ = t_ic;
+    }
     /// The simulated world behind this transport, if it is one.
     fn simulator(&mut self) -> Option<&mut dyn Simulator> {
+        None
+    }
+    /// The simulated S-FSK network behind this transport, if it is one.
+    fn sfsk(&mut self) -> Option<&mut sfsk::SfskTransport> {
         None
     }
 }

@@ -5,9 +5,36 @@
 //! serves). Its clock is the network's virtual time.
 
 use super::{LinkState, Transport};
+use plm_core::st7570::MacSync;
 use plm_core::time::Instant;
 use plm_sim::st7570::net::{NetConfig, Network};
 use plm_sim::Ports;
+
+/// Noise added at a node cut off by the Network view, dBµV: far above
+/// what its neighbours' frames arrive with on the default line (about
+/// 100 dBµV), so that it hears nothing.
+pub const CUT_OFF_NOISE_DBUV: f64 = 110.0;
+
+/// A simulated Server as the Network view shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimServer {
+    /// Its node number along the line (1..).
+    pub node: usize,
+    /// Its local MAC address.
+    pub address: u16,
+    /// Whether it relays (000Bh).
+    pub repeater: bool,
+    /// Its modem is synchronized (status message SYNC bit).
+    pub synchronized: bool,
+    /// Cut off by noise at its end of the line.
+    pub cut_off: bool,
+    /// Frames addressed to it, and its answers confirmed.
+    pub indicated: u64,
+    /// Its answers confirmed LM_OK.
+    pub answered: u64,
+    /// Its last synchronization changes, newest last.
+    pub syncs: Vec<(Instant, MacSync)>,
+}
 
 /// Node 0 of a simulated S-FSK network, as its host sees it.
 #[derive(Debug, Clone)]
@@ -24,6 +51,51 @@ impl SfskTransport {
         let mut net = Network::new(NetConfig::served_line(nodes, 1, seed));
         net.set_baud_of(0, baud);
         SfskTransport { net, nodes }
+    }
+
+    /// The simulated Servers (every node but the console's).
+    pub fn servers(&self) -> Vec<SimServer> {
+        self.net.nodes[1..]
+            .iter()
+            .enumerate()
+            .filter_map(|(i, n)| {
+                let r = n.responder.as_ref()?;
+                Some(SimServer {
+                    node: i + 1,
+                    address: r.address,
+                    repeater: matches!(n.driver.modem.mib().byte(0x000B, 0) & 0x03, 1 | 3),
+                    synchronized: n.driver.modem.synchronized(),
+                    cut_off: n.extra_noise_dbuv.is_some(),
+                    indicated: r.indicated,
+                    answered: r.answered,
+                    syncs: r.syncs.iter().cloned().collect(),
+                })
+            })
+            .collect()
+    }
+
+    /// Cuts node `node` off (noise at its end of the line) or restores it.
+    pub fn cut_off(&mut self, node: usize, cut: bool) {
+        if let Some(n) = self.net.nodes.get_mut(node) {
+            n.extra_noise_dbuv = cut.then_some(CUT_OFF_NOISE_DBUV);
+        }
+    }
+
+    /// Node `node`'s host has its modem send an alarm.
+    pub fn raise_alarm(&mut self, node: usize) {
+        if let Some(r) = self
+            .net
+            .nodes
+            .get_mut(node)
+            .and_then(|n| n.responder.as_mut())
+        {
+            r.raise_alarm();
+        }
+    }
+
+    /// Every modem's MAC timeouts run `scale` times faster from now on.
+    pub fn set_timeout_scale(&mut self, scale: u64) {
+        self.net.set_timeout_scale(scale);
     }
 }
 
@@ -75,5 +147,9 @@ impl Transport for SfskTransport {
     fn poll(&mut self, until: Instant) -> Vec<(Instant, u8)> {
         self.net.advance_to(until);
         self.net.host_read_of(0)
+    }
+
+    fn sfsk(&mut self) -> Option<&mut SfskTransport> {
+        Some(self)
     }
 }

@@ -98,6 +98,25 @@ pub struct Settings {
 /// Called once, with the reason in words, when the port is lost.
 pub type OnLost = Rc<dyn Fn(String)>;
 
+/// A modem T_IC under which a frame's bytes are written together, T_REQ
+/// released after them instead of between STX and the rest: WebSerial
+/// gives no timing between a write and a signal change (each a USB
+/// transfer, queued by the browser), while the ST7570's T_IC of 5
+/// characters is 869 µs at 57600 baud (ST7570 UM 5.2.2, 6.5.12). The
+/// ST7580's 10 ms (UM0932 3.2.6) keeps the manual's order.
+pub const WHOLE_FRAMES_BELOW: plm_core::time::Duration = 10_000;
+
+/// How late a USB-UART adapter behind WebSerial may deliver bytes: an
+/// FTDI chip holds received bytes up to its latency timer (16 ms by
+/// default), and the browser queues reads, writes and signal changes
+/// behind it (each a USB transfer; through the e2e suite's scripted port
+/// a T_REQ-to-status round trip took up to about 40 ms on a busy
+/// machine). The host waits this much longer for the modem (T_POLL,
+/// T_ACK, T_IC between received bytes); the ST7570's T_POLL of 20 ms
+/// (ST7570 UM Table 14) is otherwise shorter than one held packet. Only a
+/// slower retry is lost when the modem really is silent.
+pub const LATENCY: plm_core::time::Duration = 50_000;
+
 /// What the output queue carries out, in order.
 enum Op {
     Write(Vec<u8>),
@@ -128,6 +147,9 @@ struct Shared {
     dtr: Option<bool>,
     /// Whether each RTS change is sent twice ([`Settings::rts_twice`]).
     rts_twice: bool,
+    /// Whether a frame's bytes are written together even when T_REQ is
+    /// to change between them ([`WHOLE_FRAMES_BELOW`]).
+    whole_frames: bool,
     /// Non-fatal receive errors (framing, parity, break, overrun) so far.
     receive_errors: u32,
     disconnect_listener: Option<Closure<dyn FnMut(web_sys::Event)>>,
@@ -290,6 +312,7 @@ impl WebSerialTransport {
             rts,
             dtr: None,
             rts_twice: settings.rts_twice,
+            whole_frames: false,
             receive_errors: 0,
             disconnect_listener: None,
             on_lost: Some(on_lost),
@@ -325,6 +348,19 @@ impl WebSerialTransport {
             if let (Op::Write(more), Some(Op::Write(queued))) = (&op, s.ops.back_mut()) {
                 queued.extend_from_slice(more);
                 return;
+            }
+            // STX, T_REQ released, the rest (UM0932 3.2.8, ST7570 UM
+            // 5.2.2): with a modem that allows less than WebSerial can time
+            // between two writes, the rest joins the STX and T_REQ is
+            // released just after (docs/console.md, "Real adapters").
+            if let (true, Op::Write(more)) = (s.whole_frames, &op) {
+                let n = s.ops.len();
+                if n >= 2 && matches!(s.ops[n - 1], Op::Rts(_)) {
+                    if let Op::Write(queued) = &mut s.ops[n - 2] {
+                        queued.extend_from_slice(more);
+                        return;
+                    }
+                }
             }
             s.ops.push_back(op);
         }
@@ -369,6 +405,14 @@ impl Transport for WebSerialTransport {
     fn set_treq(&mut self, asserted: bool) {
         let rts = self.polarity.rts(asserted);
         self.push(Op::Rts(rts));
+    }
+
+    fn latency(&self) -> plm_core::time::Duration {
+        LATENCY
+    }
+
+    fn set_byte_gap_limit(&mut self, t_ic: plm_core::time::Duration) {
+        self.shared.borrow_mut().whole_frames = t_ic < WHOLE_FRAMES_BELOW;
     }
 
     /// Every byte received so far. Its time is when the page got it,

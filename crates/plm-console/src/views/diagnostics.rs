@@ -28,7 +28,7 @@ pub fn DiagnosticsView() -> impl IntoView {
 }
 
 /// Named values of `data` under `layout`, as table rows.
-fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoView {
+pub(crate) fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoView {
     plm_core::mib::describe(layout, &data)
         .into_iter()
         .map(|(f, v)| {

@@ -80,6 +80,9 @@ pub fn ModemView() -> impl IntoView {
                 " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>
+        <div class="cards" hidden=move || objects.get().1 != plm_core::link::Dialect::St7570>
+            <super::sfsk_setup::SetupCard/>
+        </div>
         <div class="mib-list">
             {move || {
                 let (list, dialect) = objects.get();
@@ -205,15 +208,19 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
     let secret = dialect == plm_core::link::Dialect::St7580 && idx == index::SS_KEY as u16;
     let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
     let inputs = RwSignal::new(inputs_of(object, object.default));
+    const NOT_READ: &str = "not read yet: the form shows the factory default";
+    let status = RwSignal::new(String::from(NOT_READ));
     Effect::new(move |_| {
         if let Some(v) = read_value.get() {
             inputs.set(inputs_of(object, &v));
+            // Read elsewhere (Read all, a profile, the set-up card): say so
+            // instead of "not read yet".
+            if status.with_untracked(|s| s == NOT_READ) {
+                status.set("read from the modem".into());
+            }
         }
     });
     let problems = RwSignal::new(Problems::default());
-    let status = RwSignal::new(String::from(
-        "not read yet: the form shows the factory default",
-    ));
     let reveal = RwSignal::new(false);
     let masked = Signal::derive(move || secret && !reveal.get());
     let base = move || {

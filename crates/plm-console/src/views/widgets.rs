@@ -66,3 +66,32 @@ pub fn note(id: &'static str, class: &'static str, text: RwSignal<Option<String>
     }
     .into_any()
 }
+
+/// A table of text cells, redrawn from `rows`: `columns` gives each
+/// column's heading and the class of its cells; a row's first cell is
+/// also its `data-key` (for finding it). One renderer for every such
+/// table: each table written as its own `view!` costs the console's wasm
+/// a copy of the element code.
+#[inline(never)]
+pub fn text_table(
+    id: &'static str,
+    columns: &'static [(&'static str, &'static str)],
+    rows: Box<dyn Fn() -> Vec<Vec<String>> + Send + Sync>,
+) -> AnyView {
+    view! {
+        <table class="log" id=id>
+            <thead><tr>{columns.iter().map(|(h, _)| view! { <th>{*h}</th> }).collect_view()}</tr></thead>
+            <tbody>
+                {move || rows().into_iter().map(|cells| {
+                    let key = cells.first().cloned().unwrap_or_default();
+                    view! {
+                        <tr data-key=key>
+                            {cells.into_iter().zip(columns).map(|(text, (_, class))| view! { <td class=*class>{text}</td> }).collect_view()}
+                        </tr>
+                    }
+                }).collect_view()}
+            </tbody>
+        </table>
+    }
+    .into_any()
+}

@@ -201,6 +201,14 @@ impl Network {
         self.refresh_node(i);
     }
 
+    /// Every modem's MAC timeouts (0002h-0004h, 0009h) run `scale` times
+    /// faster from now on, so that a demo sees a timeout of minutes.
+    pub fn set_timeout_scale(&mut self, scale: u64) {
+        for n in &mut self.nodes {
+            n.driver.modem.set_timeout_scale(scale);
+        }
+    }
+
     /// Node `i`'s frames received so far, decoded in `layer`.
     pub fn frames(&self, i: usize, layer: Layer) -> Vec<Command> {
         self.nodes[i].driver.frames(layer)

@@ -12,8 +12,12 @@ use super::drive::ModemDriver;
 use super::mode;
 use plm_core::link::host::Event;
 use plm_core::st7570::mib::{index, object, PlcConfiguration};
-use plm_core::st7570::{code, Address, Command, Credit, Layer, MacData};
+use plm_core::st7570::{code, Address, Command, Credit, Layer, MacData, MacSync};
+use plm_core::time::Instant;
 use std::collections::VecDeque;
+
+/// Synchronization changes a [`Responder`] keeps, newest last.
+pub const SYNC_HISTORY: usize = 16;
 
 /// A Server's host.
 #[derive(Debug, Clone)]
@@ -28,6 +32,10 @@ pub struct Responder {
     pub indicated: u64,
     /// Answers the modem confirmed LM_OK.
     pub answered: u64,
+    /// The modem's last [`SYNC_HISTORY`] CMD_SynchroIndications (Table
+    /// 18), when they came: what a demo shows of a Server's
+    /// synchronization.
+    pub syncs: VecDeque<(Instant, MacSync)>,
 }
 
 impl Responder {
@@ -52,7 +60,14 @@ impl Responder {
             waiting: None,
             indicated: 0,
             answered: 0,
+            syncs: VecDeque::new(),
         }
+    }
+
+    /// Has its modem send an alarm (CMD_AlarmRequest, 5.3.15) once the
+    /// requests before it are done: what a demo shows of alarms.
+    pub fn raise_alarm(&mut self) {
+        self.queue.push_back(Command::AlarmRequest);
     }
 
     /// Acts on the host events since the last call and sends the next
@@ -62,7 +77,7 @@ impl Responder {
             return;
         }
         let layer = d.modem.layer();
-        for (_, e) in std::mem::take(&mut d.events) {
+        for (at, e) in std::mem::take(&mut d.events) {
             match e {
                 Event::Frame(f) => {
                     if self
@@ -78,6 +93,12 @@ impl Responder {
                             self.queue.push_back(answer);
                         }
                         Ok(Command::DataConfirm { confirm_code: 0xFF }) => self.answered += 1,
+                        Ok(Command::MacSynchroIndication(sync)) => {
+                            if self.syncs.len() == SYNC_HISTORY {
+                                self.syncs.pop_front();
+                            }
+                            self.syncs.push_back((at, sync));
+                        }
                         _ => {}
                     }
                 }
