@@ -153,7 +153,7 @@ pub fn App() -> impl IntoView {
                             </a>
                         }
                     })
-                    .collect_view()}
+                    .map(IntoAny::into_any).collect_view()}
             </nav>
             </div>
             <main>

@@ -36,7 +36,7 @@ pub fn ConnectionBar() -> impl IntoView {
                                 </option>
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
             <span
@@ -86,7 +86,7 @@ pub fn ConnectionBar() -> impl IntoView {
                                 </option>
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
             <span class="item">
@@ -112,7 +112,7 @@ pub fn ConnectionBar() -> impl IntoView {
                 >
                     "Repeats " <b>{move || conn.retries.get()}</b>
                 </span>
-            })}
+            }).map(IntoAny::into_any)}
             <span class="item muted" title="Host-interface timeouts (MIB 09h)" hidden=move || !modem()>
                 {move || {
                     let t = conn.timeouts.get();

@@ -67,7 +67,7 @@ pub fn ModemView() -> impl IntoView {
             {plm_core::mib::ST7580
                 .iter()
                 .map(|o| view! { <MibCard object=o/> })
-                .collect_view()}
+                .map(IntoAny::into_any).collect_view()}
         </div>
     }
 }
@@ -137,7 +137,7 @@ fn Profiles() -> impl IntoView {
         </label>
         {move || (running.get()).then(|| view! {
             <button id="profile-cancel" on:click=move |_| cancel.set(true)>"Cancel"</button>
-        })}
+        }).map(IntoAny::into_any)}
         <span class="muted" id="profile-message">{move || message.get()}</span>
     }
 }
@@ -333,7 +333,7 @@ fn MibCard(object: &'static Object) -> impl IntoView {
                 {object
                     .access
                     .erase
-                    .then(|| view! { <button data-action="erase" on:click=erase>"Erase"</button> })}
+                    .then(|| view! { <button data-action="erase" on:click=erase>"Erase"</button> }).map(IntoAny::into_any)}
                 {secret
                     .then(|| {
                         view! {
@@ -382,7 +382,7 @@ fn MibCard(object: &'static Object) -> impl IntoView {
                                 />
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </tbody>
             </table>
             <p class="diff" data-role="diff">{diff}</p>
@@ -477,7 +477,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                             </option>
                         }
                     })
-                    .collect_view()}
+                    .map(IntoAny::into_any).collect_view()}
             </select>
         }
         .into_any(),

@@ -151,7 +151,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
                 on:change=move |ev| filter.update(|f| f.command = event_target_value(&ev))
             >
                 <option value="">"all"</option>
-                {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).collect_view()}
+                {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).map(IntoAny::into_any).collect_view()}
             </select>
         </label>
     }
