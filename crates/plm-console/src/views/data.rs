@@ -182,7 +182,7 @@ fn DataRequestCard() -> impl IntoView {
             .unwrap_or_default();
         [1, 2, 4, 4][ModemConfig::decode(&data).crc_length as usize & 3]
     };
-    let send = move |_| {
+    let send = move || {
         let cmd = match build(&form.get_untracked(), dl_crc_len()) {
             Ok(cmd) => cmd,
             Err(why) => {
@@ -322,7 +322,7 @@ fn DataRequestCard() -> impl IntoView {
                     prop:value=move || form.with(|f| f.payload.clone())
                     on:input=set(|f, v| f.payload = v)
                 />
-                <button id="data-send" on:click=send>"Send"</button>
+                {super::widgets::button("data-send", "Send", "", send)}
             </div>
             <p id="data-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
                 {move || result.get().map(|r| r.unwrap_or_else(|e| e))}

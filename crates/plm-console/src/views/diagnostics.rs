@@ -2,6 +2,7 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
+use super::widgets::button;
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -54,7 +55,7 @@ fn PingCard() -> impl IntoView {
     let payload = RwSignal::new(String::from("50 4c 4d 21"));
     let result = RwSignal::new(None::<Result<String, String>>);
     let history = RwSignal::new(Vec::<u64>::new());
-    let ping = move |_| {
+    let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
             Ok(d) => {
@@ -115,7 +116,7 @@ fn PingCard() -> impl IntoView {
                     on:input=move |ev| payload.set(event_target_value(&ev))
                 />
             </label>
-            <button id="ping-send" on:click=ping>"Ping"</button>
+            {button("ping-send", "Ping", "", ping)}
             <p id="ping-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
                 {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
             </p>
@@ -225,15 +226,10 @@ fn FirmwareCard() -> impl IntoView {
         <article class="card" id="firmware">
             <h3>"Firmware version"</h3>
             <p class="muted">"MIB 0Ah (UM0932 4.2.10)."</p>
-            <button
-                id="firmware-read"
-                on:click=move |_| {
-                    message.set(Some("reading…".into()));
-                    c.read_mib(index::FIRMWARE_VERSION, move |r| message.set(r.err()));
-                }
-            >
-                "Read"
-            </button>
+            {button("firmware-read", "Read", "", move || {
+                message.set(Some("reading…".into()));
+                c.read_mib(index::FIRMWARE_VERSION, move |r| message.set(r.err()));
+            })}
             <p id="firmware-value" class="big">
                 {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_uppercase()))}
             </p>
@@ -246,7 +242,7 @@ fn FirmwareCard() -> impl IntoView {
 fn ResetCard() -> impl IntoView {
     let c = use_console();
     let message = RwSignal::new(None::<String>);
-    let reset = move |_| {
+    let reset = move || {
         message.set(Some("BIO_ResetRequest sent…".into()));
         c.request(Command::BioResetRequest, move |o| {
             message.set(Some(match o {
@@ -269,7 +265,7 @@ fn ResetCard() -> impl IntoView {
             <p class="muted">
                 "BIO_ResetRequest (3Ch) restarts the modem; MIB 00h-02h survive if written since power-on (UM0932 3.3.1)."
             </p>
-            <button id="reset-send" on:click=reset>"Reset modem"</button>
+            {button("reset-send", "Reset modem", "", reset)}
             <label
                 title="DTR drives the modem's RESETN on this port (kept per port): DTR is kept released"
             >

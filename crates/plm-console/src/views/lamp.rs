@@ -167,7 +167,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 "Dimming % "
                                 <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
                             </label>
-                            <button id="lamp-dim" on:click=move |_| {
+                            {button("lamp-dim", "Dim", "", move || {
                                 match dimming_value(&level.get_untracked()) {
                                     Ok(v) => {
                                         let a = focus.get_untracked();
@@ -176,7 +176,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                     }
                                     Err(e) => note.set(Some(e)),
                                 }
-                            }>"Dim"</button>
+                            })}
                         </div>
                         <div class="form-row">
                             {button("", "Read clock", "", move || ask(Message::Service(Service::ClockGet), "clock"))}
@@ -194,12 +194,12 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         <div class="form-row pins">
                             <span class="muted">"level"</span>
                             {pin_boxes(outputs, "io-out")}
-                            <button id="lamp-io-out" on:click=move |_| {
+                            {button("lamp-io-out", "Set outputs", "", move || {
                                 match output_levels(io_config.get_untracked(), outputs.get_untracked()) {
                                     Ok(v) => ask(Message::Service(Service::OutputsSet(v)), "set GPIO outputs"),
                                     Err(e) => note.set(Some(e)),
                                 }
-                            }>"Set outputs"</button>
+                            })}
                         </div>
                         <h4>"Parameters"</h4>
                         <div class="form-row">
@@ -209,13 +209,13 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 }).map(IntoAny::into_any).collect_view()}
                             </select>
                             {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters"))}
-                            <button id="lamp-params-write" on:click=move |_| {
+                            {button("lamp-params-write", "Write", "", move || {
                                 let data = match plm_core::hex::parse(&params.get_untracked()) {
                                     Ok(d) => d,
                                     Err(e) => return note.set(Some(format!("nothing sent: {e}"))),
                                 };
                                 ask(Message::Service(Service::ParamSet { group: group.get_untracked(), data }), "write parameters")
-                            }>"Write"</button>
+                            })}
                         </div>
                         <input id="lamp-params" class="payload hex" placeholder="32 bytes, hex" prop:value=move || params.get() on:input=move |ev| params.set(event_target_value(&ev))/>
                         {move || (street.port.get().contains("simulated")).then(|| view! {

@@ -49,6 +49,7 @@ mod wasm {
     const KEY_RTS_TWICE: &str = "plm-console.serial.rts-twice";
 
     use crate::storage::load;
+    use crate::views::widgets::button;
 
     fn save(key: &str, value: &str) {
         crate::storage::store(key, Some(value));
@@ -343,13 +344,7 @@ mod wasm {
                         >
                             {ports}
                         </select>
-                        <button
-                            id="serial-choose"
-                            title="The browser asks which port this site may use, and remembers the answer."
-                            on:click=move |_| chooser.choose()
-                        >
-                            "Choose a port…"
-                        </button>
+                        {button("serial-choose", "Choose a port…", "The browser asks which port this site may use, and remembers the answer.", move || chooser.choose())}
                     </span>
                     <label
                         for="serial-baud"
@@ -441,7 +436,7 @@ mod wasm {
                         >
                             "Use the simulated modem"
                         </button>
-                        <button id="serial-close" on:click=move |_| open.set(false)>"Close"</button>
+                        {button("serial-close", "Close", "", move || open.set(false))}
                     </div>
                     {move || (message.with(Option::is_some)).then(|| view! {
                         <p class="message" id="serial-message" role="status">

@@ -3,6 +3,7 @@
 //! UART byte faults, modem reset and unplug, and what happens on the line.
 
 use super::seconds;
+use super::widgets::button;
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::st7580::fields::MODULATIONS;
@@ -95,16 +96,14 @@ fn StreetCard() -> impl IntoView {
                         .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
-            <button id="sim-apply-street" on:click=move |_| {
+            {button("sim-apply-street", "Restart the street", "", move || {
                 c.sim.lamps.set(choice.get_untracked());
                 if c.profile.get_untracked().is_street() {
                     c.connect_simulated();
                 } else {
                     c.set_profile(crate::profile::Profile::StreetBoard);
                 }
-            }>
-                "Restart the street"
-            </button>
+            })}
             <FailureRate/>
         </article>
     }
@@ -141,7 +140,7 @@ fn FailureRate() -> impl IntoView {
                 "Random failures per lamp per lit hour "
                 {super::widgets::text_input("sim-failure-rate", "", "", Some(5), text)}
             </label>
-            {super::widgets::button("sim-apply-failures", "Apply", "", apply)}
+            {button("sim-apply-failures", "Apply", "", apply)}
         </div>
         {super::widgets::note("sim-failure-note", "muted", message)}
     }
@@ -184,12 +183,10 @@ fn TopologyCard() -> impl IntoView {
                         .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
-            <button id="sim-apply-topology" on:click=move |_| {
+            {button("sim-apply-topology", "Restart the simulation", "", move || {
                 c.sim.nodes.set(choice.get_untracked());
                 c.set_profile(crate::profile::Profile::Modem);
-            }>
-                "Restart the simulation"
-            </button>
+            })}
             <p>
                 {move || format!("Running: {} modem(s); peers echoed {} frame(s).", c.sim.nodes.get(), c.sim.echoed.get())}
             </p>
@@ -205,12 +202,8 @@ fn ModemFaultsCard() -> impl IntoView {
         <article class="card" id="sim-modem">
             <h3>"Modem and cable"</h3>
             <div class="buttons">
-                <button id="sim-reset" on:click=move |_| inject(Fault::ModemReset)>
-                    "Pull RESETN (power-on reset)"
-                </button>
-                <button id="sim-watchdog" on:click=move |_| inject(Fault::Watchdog)>
-                    "Watchdog reset"
-                </button>
+                {button("sim-reset", "Pull RESETN (power-on reset)", "", move || inject(Fault::ModemReset))}
+                {button("sim-watchdog", "Watchdog reset", "", move || inject(Fault::Watchdog))}
                 <button
                     id="sim-plug"
                     on:click=move |_| {
@@ -253,7 +246,7 @@ fn LineCard() -> impl IntoView {
     let loss = RwSignal::new("0".to_string());
     let corruption = RwSignal::new("0".to_string());
     let message = RwSignal::new(None::<String>);
-    let apply = move |_| {
+    let apply = move || {
         let noise_dbuv = match super::decimal(&noise.get_untracked()) {
             Some(v) if (0.0..=130.0).contains(&v) => v,
             _ => {
@@ -289,7 +282,7 @@ fn LineCard() -> impl IntoView {
             <TextField label="Noise floor (dBµV) " id="sim-noise" size=5 value=noise/>
             <TextField label="Frame loss (%) " id="sim-loss" size=4 value=loss/>
             <TextField label="Corruption (%) " id="sim-corruption" size=4 value=corruption/>
-            <button id="sim-apply-line" on:click=apply>"Apply"</button>
+            {button("sim-apply-line", "Apply", "", apply)}
             <p class="muted">{move || message.get()}</p>
         </article>
     }
@@ -307,7 +300,7 @@ fn UartCard() -> impl IntoView {
         c.with_simulator(|s| s.inject(f));
         message.set(Some("armed: it hits the next byte".into()));
     };
-    let apply = move |_| {
+    let apply = move || {
         let (Some(drop), Some(corrupt), Some(delay)) = (
             percent(&drop.get_untracked()),
             percent(&corrupt.get_untracked()),
@@ -346,27 +339,15 @@ fn UartCard() -> impl IntoView {
                 </select>
             </label>
             <div class="buttons">
-                <button id="sim-drop" on:click=move |_| inject(Fault::DropByte(dir.get_untracked()))>
-                    "Drop next byte"
-                </button>
-                <button
-                    id="sim-corrupt"
-                    on:click=move |_| inject(Fault::CorruptByte(dir.get_untracked(), 0x10))
-                >
-                    "Corrupt next byte"
-                </button>
-                <button
-                    id="sim-delay"
-                    on:click=move |_| inject(Fault::DelayByte(dir.get_untracked(), 15 * MS))
-                >
-                    "Delay next byte 15 ms"
-                </button>
+                {button("sim-drop", "Drop next byte", "", move || inject(Fault::DropByte(dir.get_untracked())))}
+                {button("sim-corrupt", "Corrupt next byte", "", move || inject(Fault::CorruptByte(dir.get_untracked(), 0x10)))}
+                {button("sim-delay", "Delay next byte 15 ms", "", move || inject(Fault::DelayByte(dir.get_untracked(), 15 * MS)))}
             </div>
             <p class="muted">"At random, for every byte this way:"</p>
             <TextField label="drop % " id="sim-p-drop" size=4 value=drop/>
             <TextField label="corrupt % " id="sim-p-corrupt" size=4 value=corrupt/>
             <TextField label="delay % " id="sim-p-delay" size=4 value=delay/>
-            <button id="sim-apply-uart" on:click=apply>"Apply"</button>
+            {button("sim-apply-uart", "Apply", "", apply)}
             <p class="muted">{move || message.get()}</p>
         </article>
     }

@@ -49,9 +49,7 @@ pub fn StreetView() -> impl IntoView {
         <div class="street">
             <div class="toolbar">
                 <span class="muted" id="street-port">{move || street.port.get()}</span>
-                <button id="street-discover" on:click=move |_| street.act(|s| s.discover())>
-                    "Discover"
-                </button>
+                {button("street-discover", "Discover", "", move || street.act(|s| s.discover()))}
                 <SweepControl/>
                 <input
                     id="street-filter"
@@ -257,7 +255,7 @@ fn GroupActions(
             (Ok(()), Some(l)) => format!("dimming {v} % sent to {} lamp(s)", l.len()),
         }));
     };
-    let set_clocks = move |_| {
+    let set_clocks = move || {
         let c = computer_clock();
         let r = street.act(|s| {
             s.request(
@@ -284,9 +282,7 @@ fn GroupActions(
                 {move || format!("Dim selected ({})", selected.with(|s| s.len()))}
             </button>
             {button("street-dim-all", "Dim all (broadcast)", "", move || dim(None))}
-            <button id="street-clock-all" on:click=set_clocks title="sets every lamp's clock to this computer's local time">
-                "Set all clocks from this computer"
-            </button>
+            {button("street-clock-all", "Set all clocks from this computer", "sets every lamp's clock to this computer's local time", set_clocks)}
             <button
                 id="street-clock-selected"
                 prop:disabled=move || selected.with(|s| s.is_empty())
