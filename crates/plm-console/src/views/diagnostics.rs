@@ -2,7 +2,7 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
-use super::widgets::button;
+use super::widgets::{button, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -108,13 +108,7 @@ fn PingCard() -> impl IntoView {
             <p class="muted">"PingRequest (2Ch): the modem sends the payload back (UM0932 3.3.10)."</p>
             <label>
                 "Payload (hex) "
-                <input
-                    id="ping-payload"
-                    class="hex"
-                    size="30"
-                    prop:value=move || payload.get()
-                    on:input=move |ev| payload.set(event_target_value(&ev))
-                />
+                {text_input("ping-payload", "hex", "", Some(30), payload)}
             </label>
             {button("ping-send", "Ping", "", ping)}
             <p id="ping-result" class:problem=move || matches!(result.get(), Some(Err(_)))>

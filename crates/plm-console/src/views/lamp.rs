@@ -3,7 +3,7 @@
 //! ballast reset, and on a simulated street the faults a demo needs.
 
 use super::street::{computer_clock, dimming_value};
-use super::widgets::button;
+use super::widgets::{button, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
 use leptos::prelude::*;
@@ -165,7 +165,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
                             <label>
                                 "Dimming % "
-                                <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                                {text_input("lamp-dim-level", "", "", Some(4), level)}
                             </label>
                             {button("lamp-dim", "Dim", "", move || {
                                 match dimming_value(&level.get_untracked()) {
@@ -217,7 +217,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 ask(Message::Service(Service::ParamSet { group: group.get_untracked(), data }), "write parameters")
                             })}
                         </div>
-                        <input id="lamp-params" class="payload hex" placeholder="32 bytes, hex" prop:value=move || params.get() on:input=move |ev| params.set(event_target_value(&ev))/>
+                        {text_input("lamp-params", "payload hex", "32 bytes, hex", None, params)}
                         {move || (street.port.get().contains("simulated")).then(|| view! {
                             <div class="form-row sim-actions">
                                 <span class="muted">"Simulator:"</span>

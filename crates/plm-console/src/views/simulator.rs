@@ -392,12 +392,7 @@ fn TextField(
     view! {
         <label>
             {label}
-            <input
-                id=id
-                size=size
-                prop:value=move || value.get()
-                on:input=move |ev| value.set(event_target_value(&ev))
-            />
+            {super::widgets::text_input(id, "", "", Some(size), value)}
         </label>
     }
 }

@@ -4,7 +4,7 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
-use super::widgets::button;
+use super::widgets::{button, text_input};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -51,12 +51,7 @@ pub fn StreetView() -> impl IntoView {
                 <span class="muted" id="street-port">{move || street.port.get()}</span>
                 {button("street-discover", "Discover", "", move || street.act(|s| s.discover()))}
                 <SweepControl/>
-                <input
-                    id="street-filter"
-                    placeholder="filter: address, state, \"trouble\""
-                    prop:value=move || filter.get()
-                    on:input=move |ev| filter.set(event_target_value(&ev))
-                />
+                {text_input("street-filter", "", "filter: address, state, \"trouble\"", None, filter)}
                 {button("street-export-csv", "Export CSV", "", move || export(false))}
                 {button("street-export-json", "Export JSON", "", move || export(true))}
             </div>
@@ -272,7 +267,7 @@ fn GroupActions(
         <div class="toolbar group">
             <label>
                 "Dimming % "
-                <input id="street-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                {text_input("street-dim-level", "", "", Some(4), level)}
             </label>
             <button
                 id="street-dim-selected"
