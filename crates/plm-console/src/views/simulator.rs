@@ -279,9 +279,9 @@ fn LineCard() -> impl IntoView {
             <p class="muted">
                 "TX level 100 dBµV at full gain, 30 dB between neighbours, 2 dB more per node in between."
             </p>
-            <TextField label="Noise floor (dBµV) " id="sim-noise" size=5 value=noise/>
-            <TextField label="Frame loss (%) " id="sim-loss" size=4 value=loss/>
-            <TextField label="Corruption (%) " id="sim-corruption" size=4 value=corruption/>
+            {text_field("Noise floor (dBµV) ", "sim-noise", 5, noise)}
+            {text_field("Frame loss (%) ", "sim-loss", 4, loss)}
+            {text_field("Corruption (%) ", "sim-corruption", 4, corruption)}
             {button("sim-apply-line", "Apply", "", apply)}
             <p class="muted">{move || message.get()}</p>
         </article>
@@ -344,9 +344,9 @@ fn UartCard() -> impl IntoView {
                 {button("sim-delay", "Delay next byte 15 ms", "", move || inject(Fault::DelayByte(dir.get_untracked(), 15 * MS)))}
             </div>
             <p class="muted">"At random, for every byte this way:"</p>
-            <TextField label="drop % " id="sim-p-drop" size=4 value=drop/>
-            <TextField label="corrupt % " id="sim-p-corrupt" size=4 value=corrupt/>
-            <TextField label="delay % " id="sim-p-delay" size=4 value=delay/>
+            {text_field("drop % ", "sim-p-drop", 4, drop)}
+            {text_field("corrupt % ", "sim-p-corrupt", 4, corrupt)}
+            {text_field("delay % ", "sim-p-delay", 4, delay)}
             {button("sim-apply-uart", "Apply", "", apply)}
             <p class="muted">{move || message.get()}</p>
         </article>
@@ -381,18 +381,19 @@ fn LineEventsCard() -> impl IntoView {
     }
 }
 
-/// A labelled text input bound to `value` (checked when applied).
-#[component]
-fn TextField(
+/// A labelled text input bound to `value` (checked when applied); a
+/// plain function rather than a component: no props type to build.
+fn text_field(
     label: &'static str,
     id: &'static str,
     size: u32,
     value: RwSignal<String>,
-) -> impl IntoView {
+) -> AnyView {
     view! {
         <label>
             {label}
             {super::widgets::text_input(id, "", "", Some(size), value)}
         </label>
     }
+    .into_any()
 }
