@@ -2,7 +2,7 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
-use super::widgets::{button, text_input};
+use super::widgets::{button, note, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -227,7 +227,7 @@ fn FirmwareCard() -> impl IntoView {
             <p id="firmware-value" class="big">
                 {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_uppercase()))}
             </p>
-            <p class="problem">{move || message.get()}</p>
+            {note("", "problem", message)}
         </article>
     }
 }
@@ -282,7 +282,7 @@ fn ResetCard() -> impl IntoView {
             >
                 "Reset modem (RESETN)"
             </button>
-            <p id="reset-result">{move || message.get()}</p>
+            {note("reset-result", "", message)}
             <h4>"Last BIO_ResetIndication"</h4>
             {move || match c.modem.last_reset.get() {
                 None => view! { <p class="muted">"None since connecting."</p> }.into_any(),
@@ -343,7 +343,7 @@ fn Counters(index: u8) -> impl IntoView {
                 None => view! { <p class="muted">"Not read yet."</p> }.into_any(),
                 Some(v) => view! { <table class="kv">{field_rows(o.fields, v)}</table> }.into_any(),
             }}
-            <p class="problem">{move || message.get()}</p>
+            {note("", "problem", message)}
         </div>
     }
 }

@@ -227,7 +227,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 {button("", "Restore supply", "", move || sim(LampAction::Join))}
                             </div>
                         }).map(IntoAny::into_any)}
-                        <p class="muted" id="lamp-note">{move || note.get().unwrap_or_default()}</p>
+                        {super::widgets::note("lamp-note", "muted", note)}
                     }.into_any()
                 }
             }}

@@ -283,7 +283,7 @@ fn LineCard() -> impl IntoView {
             {text_field("Frame loss (%) ", "sim-loss", 4, loss)}
             {text_field("Corruption (%) ", "sim-corruption", 4, corruption)}
             {button("sim-apply-line", "Apply", "", apply)}
-            <p class="muted">{move || message.get()}</p>
+            {super::widgets::note("", "muted", message)}
         </article>
     }
 }
@@ -348,7 +348,7 @@ fn UartCard() -> impl IntoView {
             {text_field("corrupt % ", "sim-p-corrupt", 4, corrupt)}
             {text_field("delay % ", "sim-p-delay", 4, delay)}
             {button("sim-apply-uart", "Apply", "", apply)}
-            <p class="muted">{move || message.get()}</p>
+            {super::widgets::note("", "muted", message)}
         </article>
     }
 }

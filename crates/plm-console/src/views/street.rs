@@ -57,7 +57,7 @@ pub fn StreetView() -> impl IntoView {
             </div>
             <GroupActions selected=selected message=message/>
             {move || (message.with(|m| m.is_some())).then(|| view! {
-                <p class="message" id="street-message">{move || message.get().unwrap_or_default()}</p>
+                {super::widgets::note("street-message", "message", message)}
             }).map(IntoAny::into_any)}
             <Alerts focus=focus/>
             <div class="street-grid" class:with-lamp=move || focus.with(|f| f.is_some())>

@@ -56,11 +56,12 @@ pub fn text_input(
     .into_any()
 }
 
-/// A paragraph showing `text`, empty while it is `None`.
+/// A paragraph showing `text`, empty while it is `None`; `id` and `class`
+/// may be empty.
 #[inline(never)]
 pub fn note(id: &'static str, class: &'static str, text: RwSignal<Option<String>>) -> AnyView {
     view! {
-        <p id=(!id.is_empty()).then_some(id) class=class>
+        <p id=(!id.is_empty()).then_some(id) class=(!class.is_empty()).then_some(class)>
             {move || text.get().unwrap_or_default()}
         </p>
     }
