@@ -48,12 +48,12 @@ pub const DEFAULT_STREET: usize = 12;
 
 /// ST7570 nodes on the line unless told otherwise: the host's modem and
 /// three Servers, the third a repeater.
-pub const DEFAULT_ST7570_NODES: usize = 4;
+pub const DEFAULT_ST7570_NODES: usize = plm_sim::st7570::net::SERVED_LINE_NODES;
 
 /// Every this many nodes along an ST7570 line, a Server is a repeater
 /// (nodes 3, 6, 9, ...): a frame then crosses at most two Servers to the
 /// next repeater, well inside a hop's reach on the default line.
-pub const REPEATER_EVERY: usize = 3;
+pub use plm_sim::st7570::net::REPEATER_EVERY;
 
 /// What is simulated behind the served port.
 pub enum World {
@@ -251,15 +251,9 @@ fn bind_st7570(
     seed: u64,
 ) -> Bound {
     use plm_sim::st7570::net::{NetConfig, Network};
-    let repeaters: Vec<usize> = (serve..nodes).filter(|i| i % REPEATER_EVERY == 0).collect();
-    let net = Network::new(NetConfig {
-        seed,
-        served: serve,
-        responders: (serve..nodes)
-            .map(|i| (i, repeaters.contains(&i)))
-            .collect(),
-        ..NetConfig::new(nodes)
-    });
+    let config = NetConfig::served_line(nodes, serve, seed);
+    let repeaters = config.repeaters();
+    let net = Network::new(config);
     let addr = addrs[0];
     let what = if serve > 1 {
         format!(

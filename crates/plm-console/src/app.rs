@@ -98,7 +98,9 @@ pub fn App() -> impl IntoView {
     let console = provide_console();
     // A simulated street is there at once, so a newcomer sees lamps on any
     // machine (DESIGN.md); `?profile=st7580` opens on the simulated modem.
-    if let Some(p) = query("profile").and_then(|k| Profile::from_key(&k)) {
+    // Else the profile chosen last time (the chip is remembered).
+    let chosen = query("profile").or_else(|| crate::storage::load(crate::stores::PROFILE_KEY));
+    if let Some(p) = chosen.and_then(|k| Profile::from_key(&k)) {
         console.profile.set(p);
     }
     // `?lamps=500`: a longer simulated street (demos, `cargo xtask bench`).
@@ -170,10 +172,14 @@ pub fn App() -> impl IntoView {
                     <ModemView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Data>
-                    <DataView/>
+                    <St7580Only what="data services (PHY, DL, SS)">
+                        <DataView/>
+                    </St7580Only>
                 </Panel>
                 <Panel tab=tab which=Tab::Diagnostics>
-                    <DiagnosticsView/>
+                    <St7580Only what="diagnostics (ping, reset, counters, firmware)">
+                        <DiagnosticsView/>
+                    </St7580Only>
                 </Panel>
                 <Panel tab=tab which=Tab::Simulator>
                     <SimulatorView/>
@@ -197,6 +203,28 @@ fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
         >
             {children()}
         </section>
+    }
+}
+
+/// A view of what only the ST7580 has: shown unless the ST7570 profile
+/// is chosen, which says where its counterparts are meanwhile.
+#[component]
+fn St7580Only(what: &'static str, children: ChildrenFn) -> impl IntoView {
+    let console = use_console();
+    let st7570 = move || console.profile.get() == Profile::St7570;
+    view! {
+        <Show
+            when=move || !st7570()
+            fallback=move || view! {
+                <article class="card">
+                    <p class="muted">
+                        {format!("These ST7580 {what} do not apply to the ST7570. Its MIB is in the Modem view and its frames, decoded in its access layer, in Traffic.")}
+                    </p>
+                </article>
+            }
+        >
+            {children()}
+        </Show>
     }
 }
 

@@ -2,6 +2,7 @@
 //! serial port, and so which session drives it. One connection at a
 //! time, simulated or over WebSerial, for every profile.
 
+use plm_core::link::Dialect;
 use plm_sim::Attach;
 
 /// What the console is connected to.
@@ -16,11 +17,19 @@ pub enum Profile {
     StreetModem,
     /// A bare ST7580's host interface (UM0932 3): the modem views.
     Modem,
+    /// A bare ST7570's host interface (ST7570 UM 5): the modem views, on
+    /// a simulated S-FSK network or a real modem.
+    St7570,
 }
 
 impl Profile {
     /// Every profile, in the order of the chooser.
-    pub const ALL: [Profile; 3] = [Profile::StreetBoard, Profile::StreetModem, Profile::Modem];
+    pub const ALL: [Profile; 4] = [
+        Profile::StreetBoard,
+        Profile::StreetModem,
+        Profile::Modem,
+        Profile::St7570,
+    ];
 
     /// In words, for the chooser.
     pub fn label(self) -> &'static str {
@@ -28,6 +37,7 @@ impl Profile {
             Profile::StreetBoard => "Street via concentrator board (USART)",
             Profile::StreetModem => "Street via bare ST7580 (console as concentrator)",
             Profile::Modem => "ST7580 modem (host interface)",
+            Profile::St7570 => "ST7570 modem (host interface, S-FSK)",
         }
     }
 
@@ -37,6 +47,7 @@ impl Profile {
             Profile::StreetBoard => "board",
             Profile::StreetModem => "concentrator",
             Profile::Modem => "st7580",
+            Profile::St7570 => "st7570",
         }
     }
 
@@ -47,7 +58,16 @@ impl Profile {
 
     /// Whether the street session drives it.
     pub fn is_street(self) -> bool {
-        self != Profile::Modem
+        matches!(self, Profile::StreetBoard | Profile::StreetModem)
+    }
+
+    /// The chip whose host interface the console speaks (the street
+    /// profiles' modem is an ST7580).
+    pub fn dialect(self) -> Dialect {
+        match self {
+            Profile::St7570 => Dialect::St7570,
+            _ => Dialect::St7580,
+        }
     }
 
     /// What a simulated node 0 is for it.

@@ -8,10 +8,13 @@
 //! - Each tick lets the transport's time run up to the page's clock in
 //!   slices of at most [`SLICE`], feeding the engine every received byte
 //!   with its arrival time and calling `handle_timeout` at its deadlines.
-//! - Requests go to the modem one at a time: UM0932 has no sequence
-//!   numbers, so an answer is matched by `code::answers` to the one request
-//!   outstanding. After a request that had to be repeated for want of an
-//!   ACK the modem may have executed it twice (protocol notes, "Known
+//! - The session knows the chip only through plm-core's description of
+//!   its host interface ([`plm_core::chip::Chip`]): request frames, which
+//!   answer closes which request, what an answer says, the decoder.
+//! - Requests go to the modem one at a time: neither chip's host interface
+//!   has sequence numbers, so an answer is matched by [`Chip::answers`] to
+//!   the one request outstanding. After a request that had to be repeated
+//!   for want of an ACK the modem may have executed it twice (protocol notes, "Known
 //!   limits"); a second answer of the same kind within [`DUPLICATE_GRACE`]
 //!   is reported as such and never taken for the next request's.
 //! - Every modem frame the engine ACKs adds a sample to the ACK latency
@@ -19,11 +22,10 @@
 //!   ACK written, against T_ACK (UM0932 3.2.8).
 
 use crate::transport::{LinkState, Transport};
-use plm_core::decode::{Decoded, Decoder};
+use plm_core::chip::{self, Chip};
+use plm_core::decode::Decoded;
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
 use plm_core::link::{Dialect, Element, LocalFrame, Source, Timeouts};
-use plm_core::st7580::mib::{index, MibObject};
-use plm_core::st7580::{code, Command};
 use plm_core::time::{Duration, Instant, MS};
 use std::collections::VecDeque;
 
@@ -123,19 +125,43 @@ impl Budget {
     }
 }
 
-/// What became of a request.
+/// What became of a request: in the session the answer's frame (`None`
+/// for a request the modem acknowledges and does not answer, [`Chip::
+/// expects_answer`]); views of one chip read it as that chip's command
+/// ([`Outcome::read`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Outcome {
+pub enum Outcome<A = Option<LocalFrame>> {
     /// The modem's answer (confirm, error or CMD_SyntaxError) and the time
-    /// from handing the request to the link to the answer's last byte.
+    /// from handing the request to the link to the answer's last byte (or
+    /// to its acknowledgement, when no answer comes).
     Answer {
         /// The answer.
-        command: Command,
+        command: A,
         /// Round-trip time, µs.
         rtt: Duration,
     },
     /// The request was not answered; why, in words, with what to do.
     Failed(String),
+}
+
+impl Outcome {
+    /// The answer as `read` makes it; a request left unanswered, or an
+    /// answer `read` refuses, fails with the reason.
+    pub fn read<A>(self, read: impl FnOnce(&LocalFrame) -> Result<A, String>) -> Outcome<A> {
+        match self {
+            Outcome::Answer {
+                command: Some(frame),
+                rtt,
+            } => match read(&frame) {
+                Ok(command) => Outcome::Answer { command, rtt },
+                Err(why) => Outcome::Failed(why),
+            },
+            Outcome::Answer { command: None, .. } => {
+                Outcome::Failed("the modem acknowledged the request and sent no answer".into())
+            }
+            Outcome::Failed(why) => Outcome::Failed(why),
+        }
+    }
 }
 
 /// Called once with the outcome of a request.
@@ -166,7 +192,9 @@ pub enum Note {
         /// When.
         at: Instant,
         /// The frame.
-        command: Command,
+        frame: LocalFrame,
+        /// Whether it says the modem reset ([`Chip::is_reset`]).
+        reset: bool,
         /// Whether it is a second answer to a request already answered.
         duplicate: bool,
     },
@@ -293,13 +321,14 @@ pub struct Tick {
 }
 
 struct Queued {
-    command: Command,
+    frame: LocalFrame,
     reply: Reply,
 }
 
 struct Active {
     ticket: Ticket,
-    command: Command,
+    /// The request.
+    request: LocalFrame,
     reply: Reply,
     submitted: Instant,
     /// Set once the modem acknowledged the request.
@@ -310,20 +339,12 @@ struct Active {
     unanswered: bool,
 }
 
-/// How long to wait for an answer once the modem acknowledged a request:
-/// a data request's confirm comes at the end of its power line frame.
-fn answer_timeout(request: u8) -> Duration {
-    match request {
-        code::PHY_DATA_REQUEST | code::DL_DATA_REQUEST | code::SS_DATA_REQUEST => 10_000 * MS,
-        _ => 2_000 * MS,
-    }
-}
-
 /// The host side of one connection.
 pub struct Session {
     transport: Option<Box<dyn Transport>>,
     host: HostEngine,
-    decoder: Decoder,
+    /// The chip's host interface, with its decoding context.
+    chip: Box<dyn Chip>,
     queue: VecDeque<Queued>,
     active: Option<Active>,
     /// A request code whose second answer is expected until the instant.
@@ -346,13 +367,13 @@ pub struct Session {
 }
 
 impl Session {
-    /// A session over `transport` (or none yet).
-    pub fn new(transport: Option<Box<dyn Transport>>) -> Self {
+    /// A session with a chip of `dialect` over `transport` (or none yet).
+    pub fn new(transport: Option<Box<dyn Transport>>, dialect: Dialect) -> Self {
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
         Session {
             transport,
-            host: host_engine(baud),
-            decoder: Decoder::new(Dialect::St7580, Source::Any),
+            host: HostEngine::new(dialect, HostConfig::at_reset(dialect, baud)),
+            chip: chip::for_dialect(dialect),
             queue: VecDeque::new(),
             active: None,
             duplicate_of: None,
@@ -386,10 +407,16 @@ impl Session {
         }
     }
 
-    /// Replaces the transport (or disconnects with `None`); every request
-    /// not yet answered fails, with the reason the old transport was lost
-    /// if it was, else a message saying it was closed.
-    pub fn replace_transport(&mut self, transport: Option<Box<dyn Transport>>) {
+    /// The chip's host interface.
+    pub fn chip(&self) -> &dyn Chip {
+        &*self.chip
+    }
+
+    /// Replaces the transport (or disconnects with `None`) and the chip
+    /// behind it; every request not yet answered fails, with the reason
+    /// the old transport was lost if it was, else a message saying it was
+    /// closed.
+    pub fn replace_transport(&mut self, transport: Option<Box<dyn Transport>>, dialect: Dialect) {
         let why = match self.state() {
             LinkState::Disconnected(why) if self.transport.is_some() => why,
             _ => "the connection was closed before the modem answered".to_string(),
@@ -398,8 +425,8 @@ impl Session {
         let ended = self.log_time(self.now());
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
         self.log_offset = ended as i64 - transport.as_ref().map_or(0, |t| t.now()) as i64;
-        self.host = host_engine(baud);
-        self.decoder = Decoder::new(Dialect::St7580, Source::Any);
+        self.host = HostEngine::new(dialect, HostConfig::at_reset(dialect, baud));
+        self.chip = chip::for_dialect(dialect);
         self.transport = transport;
         self.pacer = Pacer::default();
         self.duplicate_of = None;
@@ -437,13 +464,14 @@ impl Session {
         self.queue.len() + self.active.is_some() as usize
     }
 
-    /// Sends `command` to the modem; `reply` is called once with its fate.
-    pub fn request(&mut self, command: Command, reply: Reply) {
+    /// Sends the request `frame` to the modem; `reply` is called once with
+    /// its fate.
+    pub fn request(&mut self, frame: LocalFrame, reply: Reply) {
         if let LinkState::Disconnected(why) = self.state() {
             self.out.replies.push((reply, Outcome::Failed(why)));
             return;
         }
-        self.queue.push_back(Queued { command, reply });
+        self.queue.push_back(Queued { frame, reply });
         let now = self.now();
         self.start_next(now);
         self.drain(now);
@@ -561,10 +589,10 @@ impl Session {
         let Some(q) = self.queue.pop_front() else {
             return;
         };
-        let ticket = self.host.submit(now, q.command.to_frame());
+        let ticket = self.host.submit(now, q.frame.clone());
         self.active = Some(Active {
             ticket,
-            command: q.command,
+            request: q.frame,
             reply: q.reply,
             submitted: now,
             deadline: None,
@@ -581,10 +609,10 @@ impl Session {
             .is_some_and(|d| now >= d);
         if late {
             if let Some(a) = self.active.take() {
-                let secs = answer_timeout(a.command.code()) / 1_000_000;
+                let secs = self.chip.answer_timeout(a.request.code) / 1_000_000;
                 let msg = format!(
                     "the modem acknowledged {} but sent no answer within {secs} s: reset the modem (Diagnostics) and try again",
-                    a.command.name().unwrap_or("the request")
+                    self.chip.code_name(a.request.code).unwrap_or("the request")
                 );
                 self.out.replies.push((a.reply, Outcome::Failed(msg)));
             }
@@ -611,7 +639,7 @@ impl Session {
     }
 
     fn traffic(&mut self, at: Instant, element: &Element, from: Source) {
-        let decoded = self.decoder.decode_from(from, element);
+        let decoded = self.chip.decode(from, element);
         self.out.notes.push(Note::Traffic {
             at: self.log_time(at),
             decoded: Box::new(decoded),
@@ -649,7 +677,16 @@ impl Session {
                     if !a.unanswered {
                         self.unanswered = 0;
                     }
-                    a.deadline = Some(now + answer_timeout(a.command.code()));
+                    a.deadline = Some(now + self.chip.answer_timeout(a.request.code));
+                }
+                let done = self
+                    .active
+                    .as_ref()
+                    .is_some_and(|a| a.ticket == t && !self.chip.expects_answer(a.request.code));
+                if let Some(a) = self.active.take_if(|_| done) {
+                    let rtt = now.saturating_sub(a.submitted);
+                    let outcome = Outcome::Answer { command: None, rtt };
+                    self.out.replies.push((a.reply, outcome));
                 }
             }
             Event::Failed(t, cause) => {
@@ -699,56 +736,43 @@ impl Session {
         let answers_active = self
             .active
             .as_ref()
-            .is_some_and(|a| code::answers(a.command.code(), f.code));
-        let parsed = Command::from_frame(&f);
+            .is_some_and(|a| self.chip.answers(a.request.code, f.code));
         if answers_active {
             let Some(a) = self.active.take() else {
                 return;
             };
             if a.repeated {
-                self.duplicate_of = Some((a.command.code(), now + DUPLICATE_GRACE));
+                self.duplicate_of = Some((a.request.code, now + DUPLICATE_GRACE));
             }
-            let outcome = match parsed {
-                Ok(command) => {
-                    self.after_answer(&a.command, &command);
-                    Outcome::Answer {
-                        command,
-                        rtt: now.saturating_sub(a.submitted),
-                    }
-                }
-                Err(e) => Outcome::Failed(format!("the modem's answer does not fit: {e}")),
+            if let Some(t) = self
+                .chip
+                .timeouts_after(&a.request, &f, self.host.config().baud)
+            {
+                self.set_timeouts(t);
+            }
+            let outcome = Outcome::Answer {
+                command: Some(f),
+                rtt: now.saturating_sub(a.submitted),
             };
             self.out.replies.push((a.reply, outcome));
             return;
         }
-        let Ok(command) = parsed else {
-            return;
-        };
         let duplicate = self
             .duplicate_of
-            .is_some_and(|(req, until)| now < until && code::answers(req, f.code));
-        if let Command::BioResetIndication(_) = command {
-            // UM0932 4.2.9 / protocol notes: a reset restores MIB 09h.
-            self.set_timeouts(Timeouts::default());
+            .is_some_and(|(req, until)| now < until && self.chip.answers(req, f.code));
+        let reset = self.chip.is_reset(&f);
+        if reset {
+            // UM0932 4.2.9, ST7570 UM 5.3.4 / protocol notes: a reset
+            // restores the objects that set the host's timeouts.
+            let config = self.host.config();
+            self.set_timeouts(Timeouts::at_reset(self.chip.dialect(), config.baud));
         }
         self.out.notes.push(Note::Unsolicited {
             at: self.log_time(now),
-            command,
+            frame: f,
+            reset,
             duplicate,
         });
-    }
-
-    /// Keeps the engine's timeouts in step with a confirmed MIB 09h write.
-    fn after_answer(&mut self, request: &Command, answer: &Command) {
-        if let (Command::MibWriteRequest { index: i, data }, Command::MibWriteConfirm) =
-            (request, answer)
-        {
-            if *i == index::HOST_INTERFACE_TIMEOUT {
-                if let Some(t) = MibObject::decode(*i, data).ok().and_then(|o| o.timeouts()) {
-                    self.set_timeouts(t);
-                }
-            }
-        }
     }
 
     fn set_timeouts(&mut self, timeouts: Timeouts) {
@@ -772,7 +796,7 @@ impl Session {
             self.out
                 .replies
                 .push((a.reply, Outcome::Failed(why.to_string())));
-            self.host = HostEngine::new(Dialect::St7580, self.host.config());
+            self.host = HostEngine::new(self.chip.dialect(), self.host.config());
             if let Some(t) = self.transport.as_mut() {
                 t.set_treq(false);
             }
@@ -787,16 +811,6 @@ impl Session {
     }
 }
 
-fn host_engine(baud: u32) -> HostEngine {
-    HostEngine::new(
-        Dialect::St7580,
-        HostConfig {
-            baud,
-            ..HostConfig::default()
-        },
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -805,15 +819,30 @@ mod tests {
     use std::cell::RefCell;
     use std::rc::Rc;
 
-    type Seen = Rc<RefCell<Vec<Outcome>>>;
+    use plm_core::st7580::mib::index;
+    use plm_core::st7580::Command;
+
+    type Seen = Rc<RefCell<Vec<Outcome<Command>>>>;
 
     fn session(nodes: usize) -> Session {
-        Session::new(Some(Box::new(SimTransport::new(nodes, 57_600, 7))))
+        let t = SimTransport::new(nodes, 57_600, 7);
+        Session::new(Some(Box::new(t)), Dialect::St7580)
     }
 
+    /// Keeps the outcome, the answer read as an ST7580 command.
     fn reply(seen: &Seen) -> Reply {
         let seen = seen.clone();
-        Box::new(move |o| seen.borrow_mut().push(o))
+        Box::new(move |o: Outcome| {
+            let o = o.read(|f| Command::from_frame(f).map_err(|e| e.to_string()));
+            seen.borrow_mut().push(o)
+        })
+    }
+
+    impl Session {
+        /// Sends an ST7580 command.
+        fn ask(&mut self, command: Command, reply: Reply) {
+            self.request(command.to_frame(), reply);
+        }
     }
 
     /// Ticks every 4 ms of page time (as setInterval does) for `ms`,
@@ -845,7 +874,7 @@ mod tests {
             let start = s.now();
             let n = 20;
             for _ in 0..if chained { 1 } else { n } {
-                s.request(ping(), reply(&seen));
+                s.ask(ping(), reply(&seen));
             }
             let mut last = start;
             while seen.borrow().len() < n {
@@ -855,7 +884,7 @@ mod tests {
                     r(o);
                     last = s.now();
                     if chained && seen.borrow().len() < n {
-                        s.request(ping(), reply(&seen));
+                        s.ask(ping(), reply(&seen));
                     }
                 }
                 assert!(*page < 2e7, "20 pings answered");
@@ -879,7 +908,7 @@ mod tests {
         let (mut page, mut notes) = (1_000_000.0, Vec::new());
         run(&mut s, &mut page, 40, &mut notes); // the modem boots in 20 ms
         let seen = Seen::default();
-        s.request(
+        s.ask(
             Command::PingRequest {
                 data: vec![1, 2, 3],
             },
@@ -926,7 +955,7 @@ mod tests {
         run(&mut s, &mut page, 40, &mut notes);
         let seen = Seen::default();
         for i in [index::FIRMWARE_VERSION, index::HOST_INTERFACE_TIMEOUT] {
-            s.request(Command::MibReadRequest { index: i }, reply(&seen));
+            s.ask(Command::MibReadRequest { index: i }, reply(&seen));
         }
         assert_eq!(s.outstanding(), 2);
         run(&mut s, &mut page, 200, &mut notes);
@@ -955,7 +984,7 @@ mod tests {
             .expect("simulated")
             .inject(Fault::Unplug);
         let seen = Seen::default();
-        s.request(Command::PingRequest { data: vec![] }, reply(&seen));
+        s.ask(Command::PingRequest { data: vec![] }, reply(&seen));
         run(&mut s, &mut page, 2_000, &mut notes);
         assert_eq!(
             *seen.borrow(),
@@ -970,7 +999,7 @@ mod tests {
             t.simulator().expect("simulated").inject(fault);
         }
         inject(&mut s, Fault::Plug);
-        s.request(Command::PingRequest { data: vec![] }, reply(&seen));
+        s.ask(Command::PingRequest { data: vec![] }, reply(&seen));
         inject(&mut s, Fault::Unplug);
         run(&mut s, &mut page, 4, &mut notes);
         assert_eq!(seen.borrow().len(), 2);
@@ -978,7 +1007,7 @@ mod tests {
         assert_eq!(s.outstanding(), 0);
         // Plugged back in, the next request goes through from scratch.
         inject(&mut s, Fault::Plug);
-        s.request(Command::PingRequest { data: vec![5] }, reply(&seen));
+        s.ask(Command::PingRequest { data: vec![5] }, reply(&seen));
         run(&mut s, &mut page, 200, &mut notes);
         assert!(
             matches!(&seen.borrow()[2], Outcome::Answer { command: Command::PingConfirm { data }, .. } if data == &[5]),
@@ -1000,7 +1029,10 @@ mod tests {
         };
         let first_run = last(&notes).expect("the reset indication");
         // A new simulated modem: its clock starts at 0 again.
-        s.replace_transport(Some(Box::new(SimTransport::new(1, 57_600, 8))));
+        s.replace_transport(
+            Some(Box::new(SimTransport::new(1, 57_600, 8))),
+            Dialect::St7580,
+        );
         let mut after = Vec::new();
         run(&mut s, &mut page, 40, &mut after);
         let second = last(&after).expect("its reset indication");
@@ -1016,7 +1048,7 @@ mod tests {
         let (mut page, mut notes) = (0.0, Vec::new());
         run(&mut s, &mut page, 40, &mut notes);
         let seen = Seen::default();
-        s.request(
+        s.ask(
             Command::MibWriteRequest {
                 index: index::HOST_INTERFACE_TIMEOUT,
                 data: vec![150, 30, 8],
@@ -1025,13 +1057,17 @@ mod tests {
         );
         run(&mut s, &mut page, 100, &mut notes);
         assert_eq!(s.timeouts(), Timeouts::from_ms(150, 30, 8));
-        s.request(Command::BioResetRequest, reply(&seen));
+        s.ask(Command::BioResetRequest, reply(&seen));
         run(&mut s, &mut page, 200, &mut notes);
         assert_eq!(s.timeouts(), Timeouts::default());
         assert!(notes.iter().any(|n| matches!(
             n,
             Note::Unsolicited {
-                command: Command::BioResetIndication(_),
+                frame: LocalFrame {
+                    code: plm_core::st7580::code::BIO_RESET_INDICATION,
+                    ..
+                },
+                reset: true,
                 ..
             }
         )));
@@ -1043,7 +1079,7 @@ mod tests {
         let (mut page, mut notes) = (0.0, Vec::new());
         run(&mut s, &mut page, 40, &mut notes);
         let seen = Seen::default();
-        s.request(Command::PingRequest { data: vec![9] }, reply(&seen));
+        s.ask(Command::PingRequest { data: vec![9] }, reply(&seen));
         run(&mut s, &mut page, 100, &mut notes);
         let acks = notes
             .iter()
@@ -1056,14 +1092,14 @@ mod tests {
         // Ticks every 4 ms: the page got to each byte within a tick.
         assert!(l.page.max <= 4 * MS && l.page.p50 >= l.link.p50, "{l:?}");
         // A page stalled for 30 ms shows on the page's clock only.
-        s.request(Command::PingRequest { data: vec![9] }, reply(&seen));
+        s.ask(Command::PingRequest { data: vec![9] }, reply(&seen));
         page += 30_000.0;
         let _ = s.tick(page, Budget::UNLIMITED);
         let l = s.ack_latency();
         assert_eq!(l.count, 3);
         assert!(l.link.max <= SLICE, "{l:?}");
         assert!(l.page.max > 10 * MS && l.page.max < 30 * MS, "{l:?}");
-        s.replace_transport(None);
+        s.replace_transport(None, Dialect::St7580);
         assert_eq!(s.ack_latency(), AckLatency::default());
     }
 
@@ -1096,5 +1132,64 @@ mod tests {
         s.tick(0.0, Budget::UNLIMITED);
         s.tick(5_000_000.0, Budget::UNLIMITED);
         assert_eq!(s.now(), MAX_CATCH_UP);
+    }
+
+    /// Issue 12, item 1: the same session drives a simulated ST7570
+    /// through plm-core's description of its host interface: a MIB read
+    /// and write with 16-bit indexes, the access layer followed from
+    /// 00A1h, a refusal in words, and a request the modem acknowledges
+    /// and does not answer (Table 21: a PHY CMD_DesynchroRequest) done at
+    /// its ACK.
+    #[test]
+    fn the_same_session_drives_an_st7570_through_its_description() {
+        use crate::transport::sfsk::SfskTransport;
+        use plm_core::st7570::mib::{index as i7570, PlcConfiguration};
+        use plm_core::st7570::Command as C7570;
+        let t = SfskTransport::new(2, 57_600, 7);
+        let mut s = Session::new(Some(Box::new(t)), Dialect::St7570);
+        let (mut page, mut notes) = (1_000_000.0, Vec::new());
+        run(&mut s, &mut page, 200, &mut notes);
+        let seen: Rc<RefCell<Vec<Outcome>>> = Rc::default();
+        let keep = |seen: &Rc<RefCell<Vec<Outcome>>>| -> Reply {
+            let seen = seen.clone();
+            Box::new(move |o| seen.borrow_mut().push(o))
+        };
+        let verdict = |s: &Session, o: &Outcome| match o {
+            Outcome::Answer {
+                command: Some(f), ..
+            } => s.chip().verdict(f),
+            other => panic!("{other:?}"),
+        };
+        let plc = i7570::PLC_CONFIGURATION;
+        s.request(s.chip().mib_read(plc), keep(&seen));
+        run(&mut s, &mut page, 200, &mut notes);
+        let value = verdict(&s, &seen.borrow()[0]).expect("00A1h read");
+        let mut p = PlcConfiguration::decode(&value);
+        assert_eq!(p.access_layer_mode, 1, "PHY at the factory");
+        // PHY: CMD_DesynchroRequest draws no answer (Table 21).
+        let desync = C7570::DesynchroRequest { reset: 0 }.to_frame();
+        s.request(desync.clone(), keep(&seen));
+        run(&mut s, &mut page, 200, &mut notes);
+        assert!(
+            matches!(seen.borrow()[1], Outcome::Answer { command: None, .. }),
+            "{:?}",
+            seen.borrow()[1]
+        );
+        // MAC Client.
+        (p.operating_mode, p.access_layer_mode) = (1, 2);
+        s.request(s.chip().mib_write(plc, &p.encode()), keep(&seen));
+        s.request(s.chip().mib_read(plc), keep(&seen));
+        run(&mut s, &mut page, 400, &mut notes);
+        assert_eq!(verdict(&s, &seen.borrow()[2]), Ok(p.encode()));
+        assert_eq!(verdict(&s, &seen.borrow()[3]), Ok(p.encode()));
+        // A value the chip refuses comes back in words.
+        s.request(s.chip().mib_write(plc, &[0; 3]), keep(&seen));
+        run(&mut s, &mut page, 200, &mut notes);
+        let why = verdict(&s, &seen.borrow()[4]).unwrap_err();
+        assert!(
+            why.starts_with("the modem refused it with CMD_WriteDBError: ERR_"),
+            "{why}"
+        );
+        assert!(notes.iter().any(|n| matches!(n, Note::Traffic { decoded, .. } if decoded.layer.as_deref() == Some("MAC"))));
     }
 }

@@ -12,13 +12,17 @@ use crate::transport::Transport;
 use crate::transport::{LinkState, Simulator};
 use leptos::prelude::*;
 use plm_core::app::{Concentrator, RequesterConfig};
+use plm_core::chip::Chip;
+use plm_core::link::LocalFrame;
 use plm_core::link::Timeouts;
-use plm_core::st7580::TxParams;
-use plm_core::st7580::{Command, ErrorCause};
+use plm_core::st7580::{Command, TxParams};
 use plm_core::time::Instant;
 use std::cell::RefCell;
 use std::collections::{BTreeMap, VecDeque};
 use std::rc::Rc;
+
+/// Where the profile chosen last is kept (the chip is remembered).
+pub const PROFILE_KEY: &str = "plm-console.profile";
 
 /// Seed of the simulated world (the same page, the same run).
 pub const SIM_SEED: u64 = 7580;
@@ -216,7 +220,10 @@ pub fn page_now_us() -> f64 {
 /// The console of the page; call once, in the root component.
 pub fn provide_console() -> Console {
     let console = Console {
-        session: StoredValue::new_local(Rc::new(RefCell::new(Session::new(None)))),
+        session: StoredValue::new_local(Rc::new(RefCell::new(Session::new(
+            None,
+            plm_core::link::Dialect::St7580,
+        )))),
         conn: ConnectionStore {
             state: RwSignal::new(LinkState::Disconnected("not connected".into())),
             kind: RwSignal::new(String::new()),
@@ -278,25 +285,9 @@ pub fn unexpected(answer: &Command) -> String {
     }
 }
 
-/// What is wrong with an answer, if it is a refusal, in words.
+/// What is wrong with an ST7580 answer, if it is a refusal, in words.
 pub fn refusal(answer: &Command) -> Option<String> {
-    let cause = |e: &ErrorCause| match e.name() {
-        Some(n) => n.to_string(),
-        None => format!("error {:02X}h", e.byte()),
-    };
-    use Command::*;
-    match answer {
-        BioResetError(e) | MibWriteError(e) | MibReadError(e) | MibEraseError(e)
-        | PhyDataError(e) | DlDataError(e) | SsDataError(e) => Some(format!(
-            "the modem refused it with {}: {}",
-            answer.name().unwrap_or("an error"),
-            cause(e)
-        )),
-        CmdSyntaxError { error } => Some(format!(
-            "the modem does not know command {error:02X}h (CMD_SyntaxError)"
-        )),
-        _ => None,
-    }
+    plm_core::chip::st7580_refusal(answer)
 }
 
 impl Console {
@@ -319,6 +310,12 @@ impl Console {
             );
             street.set_failure_rate(self.sim.failure_rate.get_untracked());
             Box::new(street)
+        } else if profile == Profile::St7570 {
+            Box::new(crate::transport::sfsk::SfskTransport::new(
+                plm_sim::st7570::net::SERVED_LINE_NODES,
+                baud,
+                SIM_SEED,
+            ))
         } else {
             Box::new(SimTransport::new(
                 self.sim.nodes.get_untracked(),
@@ -338,7 +335,9 @@ impl Console {
     pub fn connect_transport(&self, transport: Box<dyn Transport>) {
         let profile = self.profile.get_untracked();
         if profile.is_street() {
-            self.session().borrow_mut().replace_transport(None);
+            self.session()
+                .borrow_mut()
+                .replace_transport(None, profile.dialect());
             let baud = transport.baud();
             let conc = match profile {
                 Profile::StreetBoard => Concentrator::usart(RequesterConfig::default()),
@@ -360,7 +359,7 @@ impl Console {
             self.street.port.set(String::new());
             self.session()
                 .borrow_mut()
-                .replace_transport(Some(transport));
+                .replace_transport(Some(transport), profile.dialect());
         }
         self.street.version.update(|v| *v += 1);
         self.modem.mib.set(Default::default());
@@ -417,6 +416,7 @@ impl Console {
 
     /// Changes the profile and connects its simulated world.
     pub fn set_profile(&self, profile: Profile) {
+        crate::storage::store(PROFILE_KEY, Some(profile.key()));
         if self.profile.get_untracked() != profile {
             self.profile.set(profile);
             self.traffic.log.update(|l| l.clear());
@@ -426,7 +426,8 @@ impl Console {
 
     /// Closes the connection.
     pub fn disconnect(&self) {
-        self.session().borrow_mut().replace_transport(None);
+        let dialect = self.profile.get_untracked().dialect();
+        self.session().borrow_mut().replace_transport(None, dialect);
         *self.street.session().borrow_mut() = StreetSession::idle();
         self.street.port.set(String::new());
         self.refresh();
@@ -442,35 +443,85 @@ impl Console {
         self.refresh();
     }
 
-    /// Sends `command`; `reply` gets its outcome.
-    pub fn request(&self, command: Command, reply: impl FnOnce(Outcome) + 'static) {
-        self.session()
-            .borrow_mut()
-            .request(command, Box::new(reply));
+    /// Sends the request `frame` to the modem of any chip; `reply` gets
+    /// its outcome.
+    pub fn request_frame(&self, frame: LocalFrame, reply: impl FnOnce(Outcome) + 'static) {
+        self.session().borrow_mut().request(frame, Box::new(reply));
         self.refresh();
+    }
+
+    /// Sends an ST7580 `command` (the views of what only the ST7580 has);
+    /// `reply` gets its outcome, the answer read as an ST7580 command.
+    pub fn request(&self, command: Command, reply: impl FnOnce(Outcome<Command>) + 'static) {
+        self.request_frame(command.to_frame(), move |o| {
+            reply(o.read(|f| {
+                Command::from_frame(f).map_err(|e| format!("the modem's answer does not fit: {e}"))
+            }))
+        });
+    }
+
+    /// Reads from the chip's host interface description.
+    pub fn with_chip<R>(&self, f: impl FnOnce(&dyn Chip) -> R) -> R {
+        f(self.session().borrow().chip())
+    }
+
+    /// Sends the request `frame` of a MIB operation on object `index`;
+    /// `done` gets what the answer says ([`Chip::verdict`]), and the modem
+    /// store what the object holds now: the value confirmed (`None`), the
+    /// value written (`Some(Some(data))`), or nothing, erased
+    /// (`Some(None)`).
+    fn mib_request(
+        &self,
+        frame: LocalFrame,
+        index: u16,
+        holds: Option<Option<Vec<u8>>>,
+        done: impl FnOnce(Result<Vec<u8>, String>) + 'static,
+    ) {
+        let (c, mib) = (*self, self.modem.mib);
+        self.request_frame(frame, move |o| {
+            let got = match o {
+                Outcome::Answer {
+                    command: Some(f), ..
+                } => c.with_chip(|chip| chip.verdict(&f)),
+                Outcome::Answer { command: None, .. } => Ok(Vec::new()),
+                Outcome::Failed(why) => Err(why),
+            };
+            if let Ok(value) = &got {
+                match holds.unwrap_or_else(|| Some(value.clone())) {
+                    Some(v) => mib.update(|m| m.insert(index, v)),
+                    None => mib.update(|m| m.remove(index)),
+                }
+            }
+            done(got)
+        });
     }
 
     /// Reads MIB object `index` into the modem store; `done` gets the value
     /// or what went wrong.
-    pub fn read_mib(&self, index: u8, done: impl FnOnce(Result<Vec<u8>, String>) + 'static) {
-        let mib = self.modem.mib;
-        self.request(Command::MibReadRequest { index }, move |o| {
-            done(match o {
-                Outcome::Answer {
-                    command: Command::MibReadConfirm { data },
-                    ..
-                } => {
-                    mib.update(|m| {
-                        m.insert(index, data.clone());
-                    });
-                    Ok(data)
-                }
-                Outcome::Answer { command, .. } => {
-                    Err(refusal(&command).unwrap_or_else(|| "unexpected answer".into()))
-                }
-                Outcome::Failed(why) => Err(why),
-            })
-        });
+    pub fn read_mib(&self, index: u16, done: impl FnOnce(Result<Vec<u8>, String>) + 'static) {
+        let frame = self.with_chip(|c| c.mib_read(index));
+        self.mib_request(frame, index, None, done);
+    }
+
+    /// Writes `data` to MIB object `index`; the modem store keeps it once
+    /// confirmed.
+    pub fn write_mib(
+        &self,
+        index: u16,
+        data: Vec<u8>,
+        done: impl FnOnce(Result<Vec<u8>, String>) + 'static,
+    ) {
+        let frame = self.with_chip(|c| c.mib_write(index, &data));
+        self.mib_request(frame, index, Some(Some(data)), done);
+    }
+
+    /// Erases MIB object `index` (a chip without erase says so); the
+    /// modem store forgets its value once confirmed.
+    pub fn erase_mib(&self, index: u16, done: impl FnOnce(Result<Vec<u8>, String>) + 'static) {
+        match self.with_chip(|c| c.mib_erase(index).ok_or(c.name())) {
+            Ok(frame) => self.mib_request(frame, index, Some(None), done),
+            Err(chip) => done(Err(format!("the {chip} has no MIB erase"))),
+        }
     }
 
     /// Does something to the simulated world, if that is what is connected.
@@ -639,11 +690,16 @@ impl Console {
                 Note::Traffic { at, decoded } => traffic.push((at, *decoded)),
                 Note::Status { at, byte } => self.modem.status.set(Some((at, byte))),
                 Note::TReq(level) => set_if_changed(self.conn.treq, level),
-                Note::Unsolicited { at, command, .. } => {
-                    if let Command::BioResetIndication(r) = command {
-                        self.modem.last_reset.set(Some((at, r.byte())));
-                    }
+                Note::Unsolicited {
+                    at,
+                    frame,
+                    reset: true,
+                    ..
+                } => {
+                    let cause = frame.data.first().copied().unwrap_or(0);
+                    self.modem.last_reset.set(Some((at, cause)));
                 }
+                Note::Unsolicited { .. } => {}
                 Note::Retry { cause, .. } => {
                     self.conn.retries.update(|r| *r += 1);
                     self.conn.last_problem.set(Some(cause));

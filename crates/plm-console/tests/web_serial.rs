@@ -294,7 +294,10 @@ async fn a_port_opens_8n1_with_treq_released_and_a_ping_toggles_rts_around_the_s
             Wire::Rts(false)
         ]
     );
-    let mut d = Driven::new(Session::new(Some(Box::new(t))));
+    let mut d = Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ));
     // The modem powered on with the adapter (20 ms boot): its reset
     // indication comes through the port first.
     d.booted(1_000.0).await;
@@ -351,7 +354,10 @@ async fn the_inverted_polarity_drives_rts_the_other_way_and_the_modem_still_answ
         Wire::Rts(true),
         "T_REQ released = RTS asserted"
     );
-    let mut d = Driven::new(Session::new(Some(Box::new(t))));
+    let mut d = Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ));
     assert_eq!(
         d.answer(Command::PingRequest { data: vec![9] }).await,
         Command::PingConfirm { data: vec![9] }
@@ -372,7 +378,10 @@ async fn a_modem_reset_is_reported_through_the_port() {
     let _page = Exclusive::take().await;
     let adapter = Adapter::new(false).await;
     let (t, _) = open(&adapter, DEFAULT).await;
-    let mut d = Driven::new(Session::new(Some(Box::new(t))));
+    let mut d = Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ));
     d.run_until(100.0, |_| false).await;
     adapter.inject(Fault::ModemReset);
     d.booted(1_000.0).await;
@@ -383,7 +392,10 @@ async fn a_baud_change_reopens_the_port_at_the_new_rate_and_keeps_talking() {
     let _page = Exclusive::take().await;
     let adapter = Adapter::new(false).await;
     let (t, _) = open(&adapter, DEFAULT).await;
-    let mut d = Driven::new(Session::new(Some(Box::new(t))));
+    let mut d = Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ));
     d.session.set_baud(19_200);
     assert_eq!(d.session.transport().map(|t| t.baud()), Some(19_200));
     let reopened = d
@@ -411,11 +423,14 @@ async fn a_port_unplugged_mid_command_fails_it_in_words_and_opens_again_once_bac
     let _page = Exclusive::take().await;
     let adapter = Adapter::new(false).await;
     let (t, lost) = open(&adapter, DEFAULT).await;
-    let mut d = Driven::new(Session::new(Some(Box::new(t))));
+    let mut d = Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ));
     let outcomes = d.outcomes.clone();
     d.session.request(
-        Command::PingRequest { data: vec![1] },
-        Box::new(move |o| outcomes.borrow_mut().push(o)),
+        Command::PingRequest { data: vec![1] }.to_frame(),
+        Driven::keep(outcomes),
     );
     d.tick();
     assert_eq!(d.session.outstanding(), 1, "in flight");
@@ -443,7 +458,8 @@ async fn a_port_unplugged_mid_command_fails_it_in_words_and_opens_again_once_bac
     // Nothing is stuck: once back, the same port opens again and works.
     adapter.shim("replug");
     let (t, _) = open(&adapter, DEFAULT).await;
-    d.session.replace_transport(Some(Box::new(t)));
+    d.session
+        .replace_transport(Some(Box::new(t)), plm_core::link::Dialect::St7580);
     assert_eq!(
         d.answer(Command::PingRequest { data: vec![2] }).await,
         Command::PingConfirm { data: vec![2] }
@@ -455,7 +471,10 @@ async fn closing_lets_go_of_the_port_and_an_open_port_is_refused_in_words() {
     let _page = Exclusive::take().await;
     let adapter = Adapter::new(false).await;
     let (t, _) = open(&adapter, DEFAULT).await;
-    let mut d = Driven::new(Session::new(Some(Box::new(t))));
+    let mut d = Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ));
     // The same port twice: Web Serial refuses, the console says why.
     let second = WebSerialTransport::open(
         adapter.port().await,
@@ -468,7 +487,8 @@ async fn closing_lets_go_of_the_port_and_an_open_port_is_refused_in_words() {
         Err(why) => assert!(why.starts_with("the port is already open"), "{why}"),
         Ok(_) => panic!("opened twice"),
     }
-    d.session.replace_transport(None);
+    d.session
+        .replace_transport(None, plm_core::link::Dialect::St7580);
     let closed = d
         .run_until(1_000.0, |_| adapter.wire().last() == Some(&Wire::Close))
         .await;

@@ -18,9 +18,11 @@ use wasm_bindgen_test::*;
 wasm_bindgen_test_configure!(run_in_browser);
 
 fn simulated(nodes: usize) -> Driven {
-    Driven::new(Session::new(Some(Box::new(SimTransport::new(
-        nodes, 57_600, 7,
-    )))))
+    let t = SimTransport::new(nodes, 57_600, 7);
+    Driven::new(Session::new(
+        Some(Box::new(t)),
+        plm_core::link::Dialect::St7580,
+    ))
 }
 
 #[wasm_bindgen_test]

@@ -234,6 +234,16 @@ impl Decoder {
         }
     }
 
+    /// The ST7570 access layer the input has set so far (PHY, the factory
+    /// default, until it says otherwise); `None` for an ST7580 decoder.
+    #[cfg(feature = "st7570")]
+    pub fn layer(&self) -> Option<crate::st7570::Layer> {
+        match &self.chip {
+            Chip::St7570(c) => Some(c.layer()),
+            _ => None,
+        }
+    }
+
     /// Feeds bytes.
     pub fn push(&mut self, bytes: &[u8]) {
         self.stream.push(bytes);

@@ -11,6 +11,8 @@
 //! - [`st7580`]: every ST7580 command (UM0932 3.3) and MIB object (UM0932 4).
 //! - [`st7570`]: every ST7570 command (ST7570 UM 5.3) in PHY and MAC mode,
 //!   its status message (Table 11) and MIB objects (ST7570 UM 6).
+//! - [`chip`]: one chip's host interface as a host program needs it (MIB
+//!   requests, which answer closes which request, the decoder), for both.
 //! - [`field`]: the declarative field layouts that both the typed codecs and
 //!   the generic decoder/forms read, so a bit position is written once.
 //! - [`mib`]: the declarative MIB description (objects, access, defaults).
@@ -33,6 +35,7 @@ extern crate alloc;
 extern crate std;
 
 pub mod app;
+pub mod chip;
 pub mod decode;
 pub mod decode_app;
 pub mod field;

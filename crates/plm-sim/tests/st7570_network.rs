@@ -4,50 +4,18 @@
 //! indications, MAC frames of 1..7 subframes, repeaters, the Server
 //! synchronization machine with LOST causes 1-5, alarms both ways.
 
+mod st7570_host;
+
 use plm_core::link::host::Event;
-use plm_core::st7570::mib::{object, PlcConfiguration};
+use plm_core::st7570::mib::PlcConfiguration;
 use plm_core::st7570::{Address, Command, Credit, Layer, MacData, MacSync, Status};
 use plm_core::time::MS;
-use plm_sim::st7570::drive::Outcome;
 use plm_sim::st7570::line::SfskLine;
 use plm_sim::st7570::mode;
 use plm_sim::st7570::net::{NetConfig, Network};
+use st7570_host::{answer, configure, plc, read, write, MAC, PHY};
 
-const PHY: u8 = 1;
-const MAC: u8 = 2;
 const CLIENT: u16 = 0x0C00;
-
-fn answer(net: &mut Network, node: usize, cmd: Command) -> Command {
-    match net.request(node, &cmd, 5_000 * MS) {
-        Outcome::Answer(a) => a,
-        other => panic!("node {node} {cmd:?}: {other:?}"),
-    }
-}
-
-fn write(net: &mut Network, node: usize, index: u16, data: &[u8]) {
-    let cmd = Command::WriteDbRequest {
-        index,
-        data: data.to_vec(),
-    };
-    match answer(net, node, cmd) {
-        Command::WriteDbConfirm { .. } => {}
-        other => panic!("node {node} write {index:04X}h: {other:?}"),
-    }
-}
-
-fn read(net: &mut Network, node: usize, index: u16) -> Vec<u8> {
-    match answer(net, node, Command::ReadDbRequest { index }) {
-        Command::ReadDbConfirm { data, .. } => data,
-        other => panic!("node {node} read {index:04X}h: {other:?}"),
-    }
-}
-
-fn configure(net: &mut Network, node: usize, operating_mode: u8, layer: u8) {
-    let mut p = PlcConfiguration::decode(object(0x00A1).unwrap().default);
-    p.operating_mode = operating_mode;
-    p.access_layer_mode = layer;
-    write(net, node, 0x00A1, &p.encode());
-}
 
 fn status(net: &mut Network, node: usize) -> Status {
     read(net, node, 0x00A1);
@@ -211,8 +179,7 @@ fn a_lost_zero_crossing_or_the_wrong_mains_gives_zc_fail() {
     net.set_mains_lost(0, false);
     assert_eq!(confirm(&mut net, 0, p_sdu(1)), 0xFF);
     // 00A1h says 60 Hz on a 50 Hz line: the PLL cannot lock.
-    let mut p = PlcConfiguration::decode(object(0x00A1).unwrap().default);
-    p.operating_mode = mode::CLIENT;
+    let mut p = PlcConfiguration::decode(&plc(mode::CLIENT, PHY));
     p.mains_60_hz = true;
     write(&mut net, 0, 0x00A1, &p.encode());
     assert!(status(&mut net, 0).zc_fail);

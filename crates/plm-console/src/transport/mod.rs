@@ -6,6 +6,7 @@
 //! in the page ([`sim::SimTransport`], the default) and a real modem over
 //! WebSerial (`webserial::WebSerialTransport`, wasm32 only).
 
+pub mod sfsk;
 pub mod sim;
 /// WebSerial exists only in the browser (web-sys unstable APIs, wasm32).
 #[cfg(target_arch = "wasm32")]

@@ -15,7 +15,7 @@ pub fn ConnectionBar() -> impl IntoView {
     let conn = c.conn;
     let connected = move || conn.state.with(LinkState::is_connected);
     let profile = c.profile;
-    let modem = move || profile.get() == Profile::Modem;
+    let modem = move || !profile.get().is_street();
     view! {
         <div class="conn" id="connection" aria-label="Connection">
             <label title="What is at the other end of the serial port. Changing it restarts the simulated world (or reconnects the port with the new profile).">
@@ -91,7 +91,11 @@ pub fn ConnectionBar() -> impl IntoView {
             </label>
             <span class="item">
                 {move || if profile.get() == Profile::StreetBoard { "Board " } else { "Chip " }}
-                <b>{move || if profile.get() == Profile::StreetBoard { "STEVAL-IHP007V1 USART" } else { "ST7580" }}</b>
+                <b id="conn-chip">{move || match profile.get() {
+                    Profile::StreetBoard => "STEVAL-IHP007V1 USART",
+                    Profile::St7570 => "ST7570",
+                    _ => "ST7580",
+                }}</b>
             </span>
             <span class="item" id="conn-treq" title="T_REQ: low = the host asks to send" hidden=move || !modem()>
                 "T_REQ "
@@ -113,14 +117,16 @@ pub fn ConnectionBar() -> impl IntoView {
                     "Repeats " <b>{move || conn.retries.get()}</b>
                 </span>
             }).map(IntoAny::into_any)}
-            <span class="item muted" title="Host-interface timeouts (MIB 09h)" hidden=move || !modem()>
+            <span class="item muted" title="Host-interface timeouts (ST7580 MIB 09h; ST7570: T_IC from 000Bh)" hidden=move || !modem()>
                 {move || {
                     let t = conn.timeouts.get();
+                    // T_IC of 5 characters is under a millisecond (ST7570).
                     format!(
-                        "T_SR {} · T_ACK {} · T_IC {} ms",
+                        "T_SR {} · T_ACK {} · T_IC {}.{} ms",
                         t.t_sr / 1000,
                         t.t_ack / 1000,
                         t.t_ic / 1000,
+                        t.t_ic % 1000 / 100,
                     )
                 }}
             </span>

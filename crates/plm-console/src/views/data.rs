@@ -175,7 +175,7 @@ fn DataRequestCard() -> impl IntoView {
         let mc = c
             .modem
             .mib
-            .with_untracked(|m| m.get(&index::MODEM_CONFIG).cloned());
+            .with_untracked(|m| m.get(&(index::MODEM_CONFIG as u16)).cloned());
         let o = plm_core::st7580::mib::object(index::MODEM_CONFIG);
         let data = mc
             .or_else(|| o.map(|o| o.default.to_vec()))

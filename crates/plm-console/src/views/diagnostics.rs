@@ -214,7 +214,7 @@ fn FirmwareCard() -> impl IntoView {
     let value = move || {
         c.modem
             .mib
-            .with(|m| m.get(&index::FIRMWARE_VERSION).cloned())
+            .with(|m| m.get(&(index::FIRMWARE_VERSION as u16)).cloned())
     };
     view! {
         <article class="card" id="firmware">
@@ -222,10 +222,10 @@ fn FirmwareCard() -> impl IntoView {
             <p class="muted">"MIB 0Ah (UM0932 4.2.10)."</p>
             {button("firmware-read", "Read", "", move || {
                 message.set(Some("reading…".into()));
-                c.read_mib(index::FIRMWARE_VERSION, move |r| message.set(r.err()));
+                c.read_mib(index::FIRMWARE_VERSION as u16, move |r| message.set(r.err()));
             })}
             <p id="firmware-value" class="big">
-                {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_uppercase()))}
+                {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_ascii_uppercase()))}
             </p>
             {note("", "problem", message)}
         </article>
@@ -317,21 +317,17 @@ fn Counters(index: u8) -> impl IntoView {
     let c = use_console();
     let o = object(index).expect("06h-08h are in Table 52");
     let message = RwSignal::new(None::<String>);
-    let value = move || c.modem.mib.with(|m| m.get(&index).cloned());
+    let value = move || c.modem.mib.with(|m| m.get(&(index as u16)).cloned());
     let read = move || {
-        c.read_mib(index, move |r| message.set(r.err()));
+        c.read_mib(index as u16, move |r| message.set(r.err()));
     };
     let erase = move |_| {
-        c.request(Command::MibEraseRequest { index }, move |o| match o {
-            Outcome::Answer {
-                command: Command::MibEraseConfirm,
-                ..
-            } => {
+        c.erase_mib(index as u16, move |r| match r {
+            Ok(_) => {
                 message.set(None);
                 read();
             }
-            Outcome::Answer { command, .. } => message.set(refusal(&command)),
-            Outcome::Failed(why) => message.set(Some(why)),
+            Err(why) => message.set(Some(why)),
         });
     };
     view! {

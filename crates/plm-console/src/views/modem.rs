@@ -1,19 +1,18 @@
-//! The Modem view: every ST7580 MIB object, rendered from plm-core's
-//! declarative description. No object has a hand-written form: the rows,
-//! inputs, ranges, enums, access and defaults all come from
-//! `plm_core::mib::ST7580`, and a value is checked by `crate::mibform`
-//! (plm-core's `Field::check` and `Object::check_value`) before anything
-//! is sent.
+//! The Modem view: every MIB object of the chip connected (ST7580 or
+//! ST7570), rendered from plm-core's declarative description. No object
+//! has a hand-written form: the rows, inputs, ranges, enums, access and
+//! defaults all come from the chip's MIB (`plm_core::chip::Chip::mib`),
+//! a value is checked by `crate::mibform` (plm-core's `Field::check` and
+//! `Object::check_value`) before anything is sent, and the requests are
+//! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
 use crate::mibform::{self, Problems};
-use crate::session::Outcome;
-use crate::stores::{refusal, use_console};
+use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::field::{Field, Kind};
 use plm_core::mib::Object;
 use plm_core::st7580::mib::index;
-use plm_core::st7580::Command;
 use std::rc::Rc;
 
 type Inputs = mibform::Texts;
@@ -29,13 +28,27 @@ fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
 pub fn ModemView() -> impl IntoView {
     let c = use_console();
     let progress = RwSignal::new(None::<String>);
+    // The chip's objects, redrawn when the chip changes.
+    let objects = Memo::new(move |_| {
+        let dialect = c.profile.get().dialect();
+        (plm_core::chip::for_dialect(dialect).mib(), dialect)
+    });
     let read_all = move |_| {
-        let total = plm_core::mib::ST7580.len();
+        // What the modem has as configured now (an ST7570 in PHY mode
+        // has no MAC objects).
+        let readable: Vec<u16> = c.with_chip(|ch| {
+            ch.mib()
+                .iter()
+                .filter(|o| o.access.read && ch.has(o))
+                .map(|o| o.index)
+                .collect()
+        });
+        let total = readable.len();
         let done = RwSignal::new(0usize);
         let failed = RwSignal::new(0usize);
         progress.set(Some(format!("Reading 0 of {total}…")));
-        for o in plm_core::mib::ST7580 {
-            c.read_mib(o.index as u8, move |r| {
+        for i in readable {
+            c.read_mib(i, move |r| {
                 if r.is_err() {
                     failed.update(|f| *f += 1);
                 }
@@ -60,14 +73,21 @@ pub fn ModemView() -> impl IntoView {
             <span class="muted" id="mib-progress">{move || progress.get()}</span>
             <Profiles/>
             <span class="muted">
-                "ST7580 MIB (UM0932 4, Table 52). Values are checked as the modem checks them before anything is sent."
+                {move || match objects.get().1 {
+                    plm_core::link::Dialect::St7580 => "ST7580 MIB (UM0932 4, Table 52).",
+                    plm_core::link::Dialect::St7570 => "ST7570 MIB (ST7570 UM 6, Table 71).",
+                }}
+                " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>
         <div class="mib-list">
-            {plm_core::mib::ST7580
-                .iter()
-                .map(|o| view! { <MibCard object=o/> })
-                .map(IntoAny::into_any).collect_view()}
+            {move || {
+                let (list, dialect) = objects.get();
+                list.iter()
+                    .map(|o| view! { <MibCard object=o dialect=dialect/> })
+                    .map(IntoAny::into_any)
+                    .collect_view()
+            }}
         </div>
     }
 }
@@ -82,11 +102,8 @@ fn Profiles() -> impl IntoView {
     let cancel = RwSignal::new(false);
     let save = move |_| {
         let values = c.modem.mib.get_untracked();
-        let writable: Vec<u8> = plm_core::mib::ST7580
-            .iter()
-            .filter(|o| o.access.write)
-            .map(|o| o.index as u8)
-            .collect();
+        let writable: Vec<u16> =
+            c.with_chip(|ch| mibform::profile_objects(ch).map(|o| o.index).collect());
         let have = writable.iter().filter(|i| values.contains_key(i)).count();
         if have == 0 {
             message.set(Some(
@@ -94,7 +111,7 @@ fn Profiles() -> impl IntoView {
             ));
             return;
         }
-        let text = mibform::profile_json(&values);
+        let text = c.with_chip(|ch| mibform::profile_json(ch, &values));
         message.set(Some(
             match files::download("plm-profile.json", "application/json", &text) {
                 Ok(()) if have == writable.len() => {
@@ -116,7 +133,7 @@ fn Profiles() -> impl IntoView {
             let name = file.name();
             let list = match files::read_text(&file)
                 .await
-                .and_then(|t| mibform::parse_profile(&t))
+                .and_then(|t| c.with_chip(|ch| mibform::parse_profile(ch, &t)))
             {
                 Ok(list) => list,
                 Err(e) => {
@@ -146,7 +163,7 @@ fn Profiles() -> impl IntoView {
 /// back into the store; stops at the first refusal or on cancel.
 fn apply_profile(
     c: crate::stores::Console,
-    list: Rc<Vec<(u8, Vec<u8>)>>,
+    list: Rc<Vec<(u16, Vec<u8>)>>,
     i: usize,
     message: RwSignal<Option<String>>,
     running: RwSignal<bool>,
@@ -165,26 +182,16 @@ fn apply_profile(
         )));
         return;
     };
-    message.set(Some(format!("Writing {} of {n} ({index:02X}h)…", i + 1)));
-    c.request(Command::MibWriteRequest { index, data }, move |o| match o {
-        Outcome::Answer {
-            command: Command::MibWriteConfirm,
-            ..
-        } => c.read_mib(index, move |_| {
+    let at = c.with_chip(|ch| mibform::index_text(ch.dialect(), index));
+    message.set(Some(format!("Writing {} of {n} ({at}h)…", i + 1)));
+    c.write_mib(index, data, move |r| match r {
+        Ok(_) => c.read_mib(index, move |_| {
             apply_profile(c, list, i + 1, message, running, cancel)
         }),
-        Outcome::Answer { command, .. } => {
+        Err(why) => {
             running.set(false);
             message.set(Some(format!(
-                "Stopped at object {index:02X}h ({} of {n}): {}",
-                i + 1,
-                refusal(&command).unwrap_or_else(|| "unexpected answer".into())
-            )));
-        }
-        Outcome::Failed(why) => {
-            running.set(false);
-            message.set(Some(format!(
-                "Stopped at object {index:02X}h ({} of {n}): {why}",
+                "Stopped at object {at}h ({} of {n}): {why}",
                 i + 1
             )));
         }
@@ -193,10 +200,10 @@ fn apply_profile(
 
 /// One MIB object: its fields, read, write, erase and factory default.
 #[component]
-fn MibCard(object: &'static Object) -> impl IntoView {
+fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl IntoView {
     let c = use_console();
-    let idx = object.index as u8;
-    let secret = idx == index::SS_KEY;
+    let idx = object.index;
+    let secret = dialect == plm_core::link::Dialect::St7580 && idx == index::SS_KEY as u16;
     let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
     let inputs = RwSignal::new(inputs_of(object, object.default));
     Effect::new(move |_| {
@@ -241,37 +248,27 @@ fn MibCard(object: &'static Object) -> impl IntoView {
         problems.set(Problems::default());
         status.set("writing…".into());
         let sent = data.clone();
-        c.request(
-            Command::MibWriteRequest { index: idx, data },
-            move |o| match o {
-                Outcome::Answer {
-                    command: Command::MibWriteConfirm,
-                    ..
-                } => {
-                    status.set("written; reading back…".into());
-                    c.read_mib(idx, move |r| {
-                        status.set(match r {
-                            Ok(v) if v == sent => "written and read back: the modem has it".into(),
-                            Ok(_) => "written, but the modem reads back another value".into(),
-                            Err(e) => format!("written, but not read back: {e}"),
-                        })
-                    });
-                }
-                Outcome::Answer { command, .. } => status.set(format!(
-                    "not written: {}",
-                    refusal(&command).unwrap_or_else(|| "unexpected answer".into())
-                )),
-                Outcome::Failed(why) => status.set(format!("not written: {why}")),
-            },
-        );
+        c.write_mib(idx, mibform::write_data(object, &data), move |r| match r {
+            Ok(_) if !object.access.read => {
+                status.set("written (the object cannot be read back)".into())
+            }
+            Ok(_) => {
+                status.set("written; reading back…".into());
+                c.read_mib(idx, move |r| {
+                    status.set(match r {
+                        Ok(v) if v == sent => "written and read back: the modem has it".into(),
+                        Ok(_) => "written, but the modem reads back another value".into(),
+                        Err(e) => format!("written, but not read back: {e}"),
+                    })
+                });
+            }
+            Err(why) => status.set(format!("not written: {why}")),
+        });
     };
     let erase = move |_| {
         status.set("erasing…".into());
-        c.request(Command::MibEraseRequest { index: idx }, move |o| match o {
-            Outcome::Answer {
-                command: Command::MibEraseConfirm,
-                ..
-            } => {
+        c.erase_mib(idx, move |r| match r {
+            Ok(_) => {
                 status.set("erased; reading back…".into());
                 c.read_mib(idx, move |r| {
                     status.set(match r {
@@ -280,11 +277,7 @@ fn MibCard(object: &'static Object) -> impl IntoView {
                     })
                 });
             }
-            Outcome::Answer { command, .. } => status.set(format!(
-                "not erased: {}",
-                refusal(&command).unwrap_or_else(|| "unexpected answer".into())
-            )),
-            Outcome::Failed(why) => status.set(format!("not erased: {why}")),
+            Err(why) => status.set(format!("not erased: {why}")),
         });
     };
     let load_default = move |_| {
@@ -309,18 +302,20 @@ fn MibCard(object: &'static Object) -> impl IntoView {
     let writable = object.access.write;
 
     view! {
-        <article class="card mib" id=format!("mib-{idx:02x}")>
+        <article class="card mib" id=format!("mib-{}", mibform::index_text(dialect, idx).to_ascii_lowercase())>
             <header>
                 <h3>
-                    <span class="index">{format!("{idx:02X}h")}</span>
+                    <span class="index">{format!("{}h", mibform::index_text(dialect, idx))}</span>
                     " "
                     {object.name}
                 </h3>
-                <span class="access" title="Access (Table 52)">{object.access.label()}</span>
+                <span class="access" title="Access">{object.access.label()}</span>
                 <span class="muted">{object.section}</span>
             </header>
             <div class="actions">
-                <button data-action="read" on:click=move |_| read()>"Read"</button>
+                {object.access.read.then(|| view! {
+                    <button data-action="read" on:click=move |_| read()>"Read"</button>
+                })}
                 {writable
                     .then(|| {
                         view! {

@@ -59,7 +59,7 @@ pub struct Driven {
     pub notes: Vec<Note>,
     /// Every outcome of the requests sent through [`Driven::ask`], in
     /// order of arrival.
-    pub outcomes: Rc<RefCell<Vec<Outcome>>>,
+    pub outcomes: Rc<RefCell<Vec<Outcome<Command>>>>,
 }
 
 impl Driven {
@@ -102,14 +102,20 @@ impl Driven {
         }
     }
 
+    /// A reply that keeps the outcome, the answer read as an ST7580 command.
+    pub fn keep(outcomes: Rc<RefCell<Vec<Outcome<Command>>>>) -> plm_console::session::Reply {
+        Box::new(move |o: Outcome| {
+            let o = o.read(|f| Command::from_frame(f).map_err(|e| e.to_string()));
+            outcomes.borrow_mut().push(o)
+        })
+    }
+
     /// Sends `command` and waits (at most `limit_ms`) for its outcome.
-    pub async fn ask(&mut self, command: Command, limit_ms: f64) -> Outcome {
+    pub async fn ask(&mut self, command: Command, limit_ms: f64) -> Outcome<Command> {
         let before = self.outcomes.borrow().len();
         let outcomes = self.outcomes.clone();
-        self.session.request(
-            command.clone(),
-            Box::new(move |o| outcomes.borrow_mut().push(o)),
-        );
+        self.session
+            .request(command.to_frame(), Self::keep(outcomes));
         let answered = self
             .run_until(limit_ms, |d| d.outcomes.borrow().len() > before)
             .await;
@@ -130,7 +136,7 @@ impl Driven {
         self.notes
             .iter()
             .filter_map(|n| match n {
-                Note::Unsolicited { command, .. } => Some(command.clone()),
+                Note::Unsolicited { frame, .. } => Command::from_frame(frame).ok(),
                 _ => None,
             })
             .collect()

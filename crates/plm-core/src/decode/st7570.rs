@@ -56,6 +56,11 @@ impl Default for Context {
 }
 
 impl Context {
+    /// The layer frames are read in now.
+    pub(super) fn layer(&self) -> Layer {
+        self.modem.layer
+    }
+
     /// See [`super::Decoder::fix_layer`].
     pub(super) fn fix_layer(&mut self, layer: Layer) {
         self.modem.layer = layer;

@@ -19,8 +19,8 @@
 //! ("Host link engine", "ST7570: link").
 
 use super::rx::{is_cut_frame, Receiver};
-use super::{Dialect, Element, LocalFrame, Source, StatusMessage, Stx, Timeouts};
-use crate::time::{earliest, Duration, Instant, TxClock, MS};
+use super::{Answer, Dialect, Element, LocalFrame, Reaction, Source, StatusMessage, Stx, Timeouts};
+use crate::time::{earliest, wire_time, Duration, Instant, TxClock, MS};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
@@ -190,6 +190,13 @@ pub struct HostEngine {
     /// from the frame's last byte on the wire (UM0932 3.2.8), which is later
     /// than its own length says when an ACK was written just before it.
     tx_clock: TxClock,
+    /// The NAK of a modem frame cut short, held until the frame's
+    /// announced length would have ended on the wire (see
+    /// [`HostEngine::nak_broken`]).
+    nak_at: Option<Instant>,
+    /// Garbage that ends before this is the tail of a cut frame already
+    /// NAKed: it draws no second NAK.
+    tail_until: Instant,
 }
 
 impl HostEngine {
@@ -210,6 +217,8 @@ impl HostEngine {
             not_now: dialect.not_now_bits(),
             again_after: config.timeouts.t_ic,
             tx_clock: TxClock::default(),
+            nak_at: None,
+            tail_until: 0,
         }
     }
 
@@ -283,6 +292,7 @@ impl HostEngine {
 
     /// Bytes received from the modem at `now`.
     pub fn handle_rx(&mut self, now: Instant, bytes: &[u8]) {
+        self.send_held_nak(now);
         let mut out = Vec::new();
         for &b in bytes {
             self.rx.push(now, b, self.config.timeouts.t_ic, &mut out);
@@ -303,11 +313,13 @@ impl HostEngine {
 
     /// A deadline from [`HostEngine::poll_timeout`] has passed.
     pub fn handle_timeout(&mut self, now: Instant) {
+        self.send_held_nak(now);
         let mut out = Vec::new();
         self.rx.timeout(now, self.config.timeouts.t_ic, &mut out);
         for e in out {
             self.on_element(now, e);
         }
+        self.send_held_nak(now);
         match self.state {
             State::AwaitStatus { deadline } if now >= deadline => {
                 self.transmits.push_back(Transmit::TReq { asserted: false });
@@ -341,7 +353,7 @@ impl HostEngine {
             State::AwaitStatus { deadline } | State::AwaitAck { deadline } => Some(deadline),
         };
         let rx = self.rx.deadline(self.config.timeouts.t_ic);
-        earliest(state, rx)
+        earliest(earliest(state, rx), self.nak_at)
     }
 
     /// Accounts for `n` bytes written at `now`; returns when the last one
@@ -370,6 +382,8 @@ impl HostEngine {
                     self.send(now, Element::Nak);
                     return;
                 }
+                // The modem has finished what was cut: nothing to hold.
+                self.nak_at = None;
                 // The ACK is sent at once, well within T_ACK.
                 let answered = self.send(now, Element::Ack);
                 let started = self.rx.started_at();
@@ -400,6 +414,7 @@ impl HostEngine {
                 }
             }
             Element::Status(s) => {
+                self.nak_at = None;
                 self.last_status = Some(s);
                 if let State::AwaitStatus { .. } = self.state {
                     let not_now = s.data().first().is_some_and(|b| b & self.not_now != 0);
@@ -436,14 +451,61 @@ impl HostEngine {
                 }
             }
             e => {
-                // A broken frame from the modem: it will repeat it. One cut
-                // short by T_IC is NAKed (UM0932 3.2.7: "In other cases, it
-                // answers with a NAK"; ST7570 UM 5.2.2 alike).
                 self.last_accepted = None;
-                if is_cut_frame(self.dialect, &e) {
+                self.nak_broken(now, &e);
+            }
+        }
+    }
+
+    /// A broken frame from the modem (garbage): the modem will repeat it
+    /// if a NAK reaches it after the frame's last byte left (ST7570 UM
+    /// 5.2.2; the ST7580 repeats it after T_ACK anyway, UM0932 3.2.7). A
+    /// frame cut short by T_IC (3.2.6, 5.2.2) is NAKed ("In other cases,
+    /// it answers with a NAK"), but no earlier than its announced length
+    /// would have ended on the wire: the cut may be a stall of the line
+    /// (a USB adapter holding bytes back) while the modem is still
+    /// sending, and the ST7570 ignores an answer that comes during its
+    /// frame. Where a missed answer counts as ACK (ST7570), bytes that are
+    /// no element (a frame whose STX or length byte was lost or damaged,
+    /// the stalled tail of a frame cut before its length came) are NAKed
+    /// too, as T_IC ends them, unless they are the tail of a cut frame
+    /// already NAKed. docs/protocol-notes.md "ST7570: link".
+    fn nak_broken(&mut self, now: Instant, e: &Element) {
+        let Element::Garbage { bytes, .. } = e else {
+            return;
+        };
+        let baud = self.config.baud;
+        if is_cut_frame(self.dialect, e) {
+            let announced = bytes
+                .get(1)
+                .and_then(|&len| self.dialect.data_len(len))
+                .map(|n| self.rx.started_at() + wire_time(Dialect::frame_len(n) - 1, baud));
+            match announced {
+                Some(end) => {
+                    self.nak_at = Some(end.max(now));
+                    self.tail_until = end + self.config.timeouts.t_ack;
+                }
+                None => {
                     self.send(now, Element::Nak);
                 }
             }
+            return;
+        }
+        let silence_is_ack = matches!(
+            self.dialect
+                .modem_reaction(Answer::Silence, &self.config.timeouts),
+            Reaction::Delivered
+        );
+        if silence_is_ack && now >= self.tail_until && self.nak_at.is_none() {
+            self.send(now, Element::Nak);
+        }
+    }
+
+    /// Sends the NAK held by [`HostEngine::nak_broken`] once it is due.
+    fn send_held_nak(&mut self, now: Instant) {
+        if self.nak_at.is_some_and(|t| t <= now) {
+            self.nak_at = None;
+            self.send(now, Element::Nak);
         }
     }
 

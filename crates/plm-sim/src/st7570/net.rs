@@ -76,7 +76,39 @@ pub struct NetConfig {
     pub served: usize,
 }
 
+/// Nodes of a served network unless told otherwise: the host's modem and
+/// three Servers, the third a repeater.
+pub const SERVED_LINE_NODES: usize = 4;
+
+/// In a served network ([`NetConfig::served_line`]) every this-many-th
+/// node is a repeater (000Bh REPEAT).
+pub const REPEATER_EVERY: usize = 3;
+
 impl NetConfig {
+    /// The network `plm sim --chip st7570` and the console's simulated
+    /// ST7570 serve: nodes 0..`served` driven from outside, the others
+    /// Servers at their node number that answer what is sent to them
+    /// ([`Responder`]), every [`REPEATER_EVERY`]-th a repeater.
+    pub fn served_line(nodes: usize, served: usize, seed: u64) -> Self {
+        NetConfig {
+            seed,
+            served,
+            responders: (served..nodes)
+                .map(|i| (i, i % REPEATER_EVERY == 0))
+                .collect(),
+            ..NetConfig::new(nodes)
+        }
+    }
+
+    /// The repeaters of a [`NetConfig::served_line`].
+    pub fn repeaters(&self) -> Vec<usize> {
+        self.responders
+            .iter()
+            .filter(|(_, rep)| *rep)
+            .map(|(n, _)| *n)
+            .collect()
+    }
+
     /// `nodes` nodes, all driven from outside, on a default line.
     pub fn new(nodes: usize) -> Self {
         NetConfig {

@@ -1,0 +1,82 @@
+// Browser end-to-end journeys of PLM Console with the ST7570 (issue 12):
+// the chip chosen in the connection bar and remembered, and its MIB read,
+// written and refused through the same session and forms as the ST7580's,
+// against the simulated S-FSK network in the page.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { launchChromium, serveDist, watchedPage } from './harness.mjs';
+import { shot, tab, titles } from './journeys.mjs';
+
+let server;
+let base;
+let browser;
+
+before(async () => {
+  ({ server, base } = await serveDist());
+  browser = await launchChromium();
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((r) => (server ? server.close(r) : r()));
+});
+
+async function open(t, query = '') {
+  const context = await browser.newContext({ viewport: { width: 1400, height: 900 } });
+  const page = await watchedPage(t, context);
+  await page.goto(base + query + '#modem');
+  await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+  return page;
+}
+
+test('the ST7570 is chosen in the connection bar, remembered, and configured as a MAC Client', async (t) => {
+  const page = await open(t);
+  await page.selectOption('#profile', 'st7570');
+  await page.locator('#conn-chip', { hasText: 'ST7570' }).waitFor();
+  await page.locator('#conn-port', { hasText: 'ST7570 (simulated, 3 Servers on the line)' }).waitFor();
+  // Every ST7570 object, from the declarative MIB (Table 71).
+  await page.locator('#mib-00a1').waitFor();
+  await page.click('#mib-read-all');
+  await page.locator('#mib-progress', { hasText: /Read all \d+ objects|Read \d+ of \d+ objects/ }).waitFor({ timeout: 30_000 });
+
+  const card = page.locator('#mib-00a1');
+  const status = card.locator('[data-role=status]');
+  await card.locator('[data-action=read]').click();
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
+  assert.equal(await card.locator('[name=access_layer_mode]').inputValue(), '1');
+  // A MAC Client: operating mode 1, access layer 2 (Table 137).
+  await card.locator('[name=operating_mode]').selectOption('1');
+  await card.locator('[name=access_layer_mode]').selectOption('2');
+  await card.locator('[data-action=write]').click();
+  await status.filter({ hasText: 'written and read back: the modem has it' }).waitFor();
+  await card.locator('[data-action=read]').click();
+  await status.filter({ hasText: 'read from the modem' }).waitFor();
+  assert.equal(await card.locator('[name=operating_mode]').inputValue(), '1');
+  await shot(page, 'st7570-modem');
+
+  await tab(page, 'traffic');
+  const all = await titles(page);
+  assert.ok(all.includes('CMD_WriteDBRequest'), all.join(', '));
+  assert.ok(all.includes('CMD_ReadDBConfirm'), all.join(', '));
+  await shot(page, 'st7570-traffic');
+
+  // The chip is remembered: a reload opens on the ST7570 again.
+  await page.reload();
+  await page.locator('#conn-chip', { hasText: 'ST7570' }).waitFor({ timeout: 15_000 });
+});
+
+test('an out-of-range ST7570 value is refused in the form with the reason, and nothing is sent', async (t) => {
+  const page = await open(t, '?profile=st7570');
+  const card = page.locator('#mib-00a1');
+  await card.locator('input[name=f0]').fill('200000');
+  await card.locator('[data-action=write]').click();
+  const reason = card.locator('tr[data-field=f0] [data-role=problem]');
+  await reason.filter({ hasText: '200000 is out of range 3000..=140000 Hz' }).waitFor();
+  assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
+  await shot(page, 'st7570-refused');
+  await page.waitForTimeout(300);
+  await tab(page, 'traffic');
+  const all = await titles(page);
+  assert.ok(!all.includes('CMD_WriteDBRequest'), all.join(', '));
+});
