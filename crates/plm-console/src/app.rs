@@ -207,24 +207,28 @@ fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
 }
 
 /// A view of what only the ST7580 has: shown unless the ST7570 profile
-/// is chosen, which says where its counterparts are meanwhile.
+/// is chosen, which says where its counterparts are meanwhile. A memo of
+/// the choice rather than `<Show>` (one more generic component in the
+/// page, docs/console.md "Size"); like `<Show>`, the view is only made
+/// anew when the choice changes, so its form state survives a change
+/// between the ST7580 profiles.
 #[component]
 fn St7580Only(what: &'static str, children: ChildrenFn) -> impl IntoView {
     let console = use_console();
-    let st7570 = move || console.profile.get() == Profile::St7570;
-    view! {
-        <Show
-            when=move || !st7570()
-            fallback=move || view! {
+    let st7570 = Memo::new(move |_| console.profile.get() == Profile::St7570);
+    move || {
+        if st7570.get() {
+            view! {
                 <article class="card">
                     <p class="muted">
                         {format!("These ST7580 {what} do not apply to the ST7570. Its MIB is in the Modem view and its frames, decoded in its access layer, in Traffic.")}
                     </p>
                 </article>
             }
-        >
-            {children()}
-        </Show>
+            .into_any()
+        } else {
+            children().into_any()
+        }
     }
 }
 
@@ -239,10 +243,10 @@ fn LinkProblem() -> impl IntoView {
         {move || text().map(|t| view! {
             <div class="toast" role="status" id="link-problem">
                 <span>{t}</span>
-                <button on:click=move |_| {
+                {crate::views::widgets::button("", "Dismiss", "", move || {
                     advice.set(None);
                     problem.set(None);
-                }>"Dismiss"</button>
+                })}
             </div>
         })}
     }

@@ -2,7 +2,7 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
-use super::widgets::{button, note, text_input};
+use super::widgets::{action_button, button, note, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -321,7 +321,7 @@ fn Counters(index: u8) -> impl IntoView {
     let read = move || {
         c.read_mib(index as u16, move |r| message.set(r.err()));
     };
-    let erase = move |_| {
+    let erase = move || {
         c.erase_mib(index as u16, move |r| match r {
             Ok(_) => {
                 message.set(None);
@@ -333,8 +333,8 @@ fn Counters(index: u8) -> impl IntoView {
     view! {
         <div class="counters" id=format!("counters-{index:02x}")>
             <h4>{format!("{index:02X}h {}", o.name)}</h4>
-            <button data-action="read" on:click=move |_| read()>"Read"</button>
-            <button data-action="erase" on:click=erase>"Erase"</button>
+            {action_button("read", "Read", read)}
+            {action_button("erase", "Erase", erase)}
             {move || match value() {
                 None => view! { <p class="muted">"Not read yet."</p> }.into_any(),
                 Some(v) => view! { <table class="kv">{field_rows(o.fields, v)}</table> }.into_any(),

@@ -7,6 +7,7 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
+use super::widgets::{action_button, button};
 use crate::mibform::{self, Problems};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -33,7 +34,7 @@ pub fn ModemView() -> impl IntoView {
         let dialect = c.profile.get().dialect();
         (plm_core::chip::for_dialect(dialect).mib(), dialect)
     });
-    let read_all = move |_| {
+    let read_all = move || {
         // What the modem has as configured now (an ST7570 in PHY mode
         // has no MAC objects).
         let readable: Vec<u16> = c.with_chip(|ch| {
@@ -69,7 +70,7 @@ pub fn ModemView() -> impl IntoView {
     };
     view! {
         <div class="toolbar">
-            <button id="mib-read-all" on:click=read_all>"Read all"</button>
+            {button("mib-read-all", "Read all", "", read_all)}
             <span class="muted" id="mib-progress">{move || progress.get()}</span>
             <Profiles/>
             <span class="muted">
@@ -100,7 +101,7 @@ fn Profiles() -> impl IntoView {
     let message = RwSignal::new(None::<String>);
     let running = RwSignal::new(false);
     let cancel = RwSignal::new(false);
-    let save = move |_| {
+    let save = move || {
         let values = c.modem.mib.get_untracked();
         let writable: Vec<u16> =
             c.with_chip(|ch| mibform::profile_objects(ch).map(|o| o.index).collect());
@@ -147,13 +148,13 @@ fn Profiles() -> impl IntoView {
         });
     };
     view! {
-        <button id="profile-save" on:click=save>"Save profile"</button>
+        {button("profile-save", "Save profile", "", save)}
         <label class="button">
             "Load profile…"
             <input id="profile-load" type="file" accept=".json,application/json" on:change=load/>
         </label>
         {move || (running.get()).then(|| view! {
-            <button id="profile-cancel" on:click=move |_| cancel.set(true)>"Cancel"</button>
+            {button("profile-cancel", "Cancel", "", move || cancel.set(true))}
         }).map(IntoAny::into_any)}
         <span class="muted" id="profile-message">{move || message.get()}</span>
     }
@@ -232,7 +233,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             })
         });
     };
-    let write = move |_| {
+    let write = move || {
         let data = match mibform::build(object, &base(), &inputs.get_untracked()) {
             Ok(d) => d,
             Err(p) => {
@@ -265,7 +266,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             Err(why) => status.set(format!("not written: {why}")),
         });
     };
-    let erase = move |_| {
+    let erase = move || {
         status.set("erasing…".into());
         c.erase_mib(idx, move |r| match r {
             Ok(_) => {
@@ -280,7 +281,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             Err(why) => status.set(format!("not erased: {why}")),
         });
     };
-    let load_default = move |_| {
+    let load_default = move || {
         inputs.set(inputs_of(object, object.default));
         problems.set(Problems::default());
         status.set("factory default loaded into the form: Write to send it".into());
@@ -313,22 +314,18 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                 <span class="muted">{object.section}</span>
             </header>
             <div class="actions">
-                {object.access.read.then(|| view! {
-                    <button data-action="read" on:click=move |_| read()>"Read"</button>
-                })}
+                {object.access.read.then(|| action_button("read", "Read", read))}
                 {writable
                     .then(|| {
                         view! {
-                            <button data-action="write" on:click=write>"Write"</button>
-                            <button data-action="default" on:click=load_default>
-                                "Factory default"
-                            </button>
+                            {action_button("write", "Write", write)}
+                            {action_button("default", "Factory default", load_default)}
                         }
                     })}
                 {object
                     .access
                     .erase
-                    .then(|| view! { <button data-action="erase" on:click=erase>"Erase"</button> }).map(IntoAny::into_any)}
+                    .then(|| action_button("erase", "Erase", erase))}
                 {secret
                     .then(|| {
                         view! {

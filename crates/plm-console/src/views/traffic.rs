@@ -2,6 +2,7 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
+use super::widgets::button;
 use super::{seconds, spaced};
 use crate::stores::use_console;
 use crate::traffic::{Entry, Filter, CAPACITY};
@@ -182,7 +183,7 @@ fn PauseButton() -> impl IntoView {
 #[component]
 fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
     let c = use_console();
-    let export = move |_| {
+    let export = move || {
         let text = c.traffic.log.with_untracked(|l| l.export());
         let lines = text.lines().count();
         match files::download("plm-traffic.jsonl", "application/x-ndjson", &text) {
@@ -232,7 +233,7 @@ fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
         });
     };
     view! {
-        <button id="traffic-export" on:click=export>"Export JSONL"</button>
+        {button("traffic-export", "Export JSONL", "", export)}
         <label class="button">
             "Import JSONL…"
             <input

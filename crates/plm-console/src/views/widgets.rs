@@ -12,12 +12,19 @@ pub fn button(
     title: &'static str,
     on: impl Fn() + 'static,
 ) -> AnyView {
-    button_boxed(id, label, title, Box::new(on))
+    button_boxed(id, "", label, title, Box::new(on))
+}
+
+/// A button of a card's actions, named by `data-action` (`read`, `erase`,
+/// ...) as each card has its own.
+pub fn action_button(action: &'static str, label: &'static str, on: impl Fn() + 'static) -> AnyView {
+    button_boxed("", action, label, "", Box::new(on))
 }
 
 #[inline(never)]
 fn button_boxed(
     id: &'static str,
+    action: &'static str,
     label: &'static str,
     title: &'static str,
     on: Box<dyn Fn()>,
@@ -25,6 +32,7 @@ fn button_boxed(
     view! {
         <button
             id=(!id.is_empty()).then_some(id)
+            data-action=(!action.is_empty()).then_some(action)
             title=(!title.is_empty()).then_some(title)
             on:click=move |_| on()
         >
