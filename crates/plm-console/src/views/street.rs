@@ -103,10 +103,10 @@ pub fn StreetView() -> impl IntoView {
                             </tr>
                         </thead>
                         <tbody>
-                            <For
-                                each=move || rows.with(|r| r.iter().map(|r| r.address).collect::<Vec<_>>())
-                                key=|a| *a
-                                children=move |address| {
+                            {super::widgets::keyed_rows(
+                                move || rows.with(|r| r.iter().map(|r| row_key(r.address)).collect()),
+                                move |key| {
+                                    let address = key_address(key);
                                     let row = Memo::new(move |_| {
                                         street.version.track();
                                         let now = street.now.get();
@@ -150,8 +150,9 @@ pub fn StreetView() -> impl IntoView {
                                                 .map(IntoAny::into_any).collect_view()}
                                         </tr>
                                     }
-                                }
-                            />
+                                    .into_any()
+                                },
+                            )}
                         </tbody>
                     </table>
                     {move || (rows.with(|r| r.is_empty())).then(|| view! {
@@ -338,4 +339,17 @@ mod tests {
             .unwrap_err()
             .contains("not a dimming value"));
     }
+}
+
+/// A board address as the key of its row (6 bytes in a u64), and back.
+fn row_key(a: Address) -> u64 {
+    let mut k = [0; 8];
+    k[2..].copy_from_slice(&a.0);
+    u64::from_be_bytes(k)
+}
+
+fn key_address(key: u64) -> Address {
+    let mut a = [0; 6];
+    a.copy_from_slice(&key.to_be_bytes()[2..]);
+    Address(a)
 }

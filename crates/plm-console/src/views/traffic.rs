@@ -103,11 +103,16 @@ pub fn TrafficView() -> impl IntoView {
                         </tr>
                     </thead>
                     <tbody>
-                        <For
-                            each=move || rows.get().1
-                            key=|e| e.seq
-                            children=move |e| view! { <Row entry=e selected=selected/> }
-                        />
+                        {super::widgets::keyed_rows(
+                            move || rows.with(|r| r.1.iter().map(|e| e.seq).collect()),
+                            move |seq| {
+                                // The row of an entry shown (the log holds them in order).
+                                let entry = rows.with_untracked(|r| {
+                                    r.1.binary_search_by_key(&seq, |e| e.seq).ok().map(|i| Arc::clone(&r.1[i]))
+                                });
+                                entry.map(|e| view! { <Row entry=e selected=selected/> }).into_any()
+                            },
+                        )}
                     </tbody>
                 </table>
             </div>
