@@ -5,6 +5,7 @@
 use crate::profile::Profile;
 use crate::stores::use_console;
 use crate::transport::LinkState;
+use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_sim::BAUD_RATES;
 
@@ -21,11 +22,11 @@ pub fn ConnectionBar() -> impl IntoView {
             <label title="What is at the other end of the serial port. Changing it restarts the simulated world (or reconnects the port with the new profile).">
                 <select
                     id="profile"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Some(p) = Profile::from_key(&event_target_value(&ev)) {
                             c.set_profile(p);
                         }
-                    }
+                    })
                 >
                     {Profile::ALL
                         .into_iter()
@@ -71,11 +72,11 @@ pub fn ConnectionBar() -> impl IntoView {
                 "Baud "
                 <select
                     id="baud"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(b) = event_target_value(&ev).parse::<u32>() {
                             c.set_baud(b);
                         }
-                    }
+                    })
                 >
                     {BAUD_RATES
                         .iter()
@@ -132,13 +133,13 @@ pub fn ConnectionBar() -> impl IntoView {
             </span>
             <button
                 id="connect"
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     if c.conn.kind.get_untracked().is_empty() {
                         c.connect_simulated();
                     } else {
                         c.disconnect();
                     }
-                }
+                })
             >
                 {move || if conn.kind.get().is_empty() { "Connect" } else { "Disconnect" }}
             </button>

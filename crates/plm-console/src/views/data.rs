@@ -8,6 +8,7 @@ use super::{millis, seconds, spaced};
 use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;
+use super::widgets::on_event;
 use leptos::prelude::*;
 use plm_core::json::Json;
 use plm_core::st7580::fields::{confirm_data, tx_options, MODULATIONS};
@@ -234,7 +235,7 @@ fn DataRequestCard() -> impl IntoView {
             <div class="form-row">
                 <label>
                     "Layer "
-                    <select id="data-layer" on:change=set(|f, v| f.layer = v)>
+                    <select id="data-layer" on:change=on_event(set(|f, v| f.layer = v))>
                         <option value="phy">"PHY"</option>
                         <option value="dl" selected>"DL"</option>
                         <option value="ss">"SS"</option>
@@ -242,7 +243,7 @@ fn DataRequestCard() -> impl IntoView {
                 </label>
                 <label>
                     "Modulation "
-                    <select id="data-modulation" on:change=set(|f, v| f.modulation = v)>
+                    <select id="data-modulation" on:change=on_event(set(|f, v| f.modulation = v))>
                         {MODULATIONS
                             .iter()
                             .enumerate()
@@ -253,7 +254,7 @@ fn DataRequestCard() -> impl IntoView {
                 </label>
                 <label>
                     "Frequency "
-                    <select id="data-frequency" on:change=set(|f, v| f.frequency = v)>
+                    <select id="data-frequency" on:change=on_event(set(|f, v| f.frequency = v))>
                         <option value="high" selected>"MIB high frequency"</option>
                         <option value="low">"MIB low frequency"</option>
                         <option value="custom">"custom"</option>
@@ -265,14 +266,14 @@ fn DataRequestCard() -> impl IntoView {
                         id="data-custom-hz"
                         size="7"
                         prop:value=move || form.with(|f| f.custom_hz.clone())
-                        on:input=set(|f, v| f.custom_hz = v)
+                        on:input=on_event(set(|f, v| f.custom_hz = v))
                     />
                 </label>
                 <label hidden=move || form.with(|f| f.frequency != "custom")>
                     <input
                         type="checkbox"
                         id="data-overwrite"
-                        on:change=move |ev| form.update(|f| f.overwrite = event_target_checked(&ev))
+                        on:change=on_event(move |ev| form.update(|f| f.overwrite = event_target_checked(&ev)))
                     />
                     " overwrite MIB frequency"
                 </label>
@@ -283,14 +284,14 @@ fn DataRequestCard() -> impl IntoView {
                         size="3"
                         placeholder="MIB"
                         prop:value=move || form.with(|f| f.gain.clone())
-                        on:input=set(|f, v| f.gain = v)
+                        on:input=on_event(set(|f, v| f.gain = v))
                     />
                 </label>
                 <label>
                     <input
                         type="checkbox"
                         id="data-zc"
-                        on:change=move |ev| form.update(|f| f.zc = event_target_checked(&ev))
+                        on:change=on_event(move |ev| form.update(|f| f.zc = event_target_checked(&ev)))
                     />
                     " zero-crossing synchronisation"
                 </label>
@@ -300,7 +301,7 @@ fn DataRequestCard() -> impl IntoView {
                         id="data-header-length"
                         size="3"
                         prop:value=move || form.with(|f| f.header_length.clone())
-                        on:input=set(|f, v| f.header_length = v)
+                        on:input=on_event(set(|f, v| f.header_length = v))
                     />
                 </label>
             </div>
@@ -309,7 +310,7 @@ fn DataRequestCard() -> impl IntoView {
                     "Payload as "
                     <select
                         id="data-payload-kind"
-                        on:change=move |ev| form.update(|f| f.text = event_target_value(&ev) == "text")
+                        on:change=on_event(move |ev| form.update(|f| f.text = event_target_value(&ev) == "text"))
                     >
                         <option value="text" selected>"text"</option>
                         <option value="hex">"hex"</option>
@@ -320,7 +321,7 @@ fn DataRequestCard() -> impl IntoView {
                     class="payload"
                     size="60"
                     prop:value=move || form.with(|f| f.payload.clone())
-                    on:input=set(|f, v| f.payload = v)
+                    on:input=on_event(set(|f, v| f.payload = v))
                 />
                 {super::widgets::button("data-send", "Send", "", send)}
             </div>

@@ -6,6 +6,7 @@ use super::widgets::{action_button, button, note, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
+use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::field::Field;
 use plm_core::st7580::fields::{reset_data, status};
@@ -267,7 +268,7 @@ fn ResetCard() -> impl IntoView {
                     type="checkbox"
                     id="resetn-on-dtr"
                     prop:checked=move || c.conn.resetn_on_dtr.get()
-                    on:change=move |ev| c.set_resetn_on_dtr(event_target_checked(&ev))
+                    on:change=on_event(move |ev| c.set_resetn_on_dtr(event_target_checked(&ev)))
                 />
                 " RESETN wired to DTR"
             </label>
@@ -275,10 +276,10 @@ fn ResetCard() -> impl IntoView {
                 id="reset-resetn"
                 hidden=move || !c.conn.resetn_on_dtr.get()
                 title="DTR asserted 20 ms: a hardware reset"
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     c.pulse_resetn();
                     message.set(Some("RESETN pulsed: BIO_ResetIndication follows.".into()));
-                }
+                })
             >
                 "Reset modem (RESETN)"
             </button>

@@ -6,6 +6,7 @@ use super::street::{computer_clock, dimming_value};
 use super::widgets::{button, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
+use super::widgets::on_event;
 use leptos::prelude::*;
 use plm_core::app::service::Service;
 use plm_core::app::{Address, Message, Request};
@@ -21,10 +22,10 @@ fn pin_boxes(mask: RwSignal<u8>, id: &'static str) -> impl IntoView {
                     id=format!("{id}-{bit}")
                     title=format!("IO{bit}")
                     prop:checked=move || mask.get() & (1 << bit) != 0
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         let on = event_target_checked(&ev);
                         mask.update(|m| if on { *m |= 1 << bit } else { *m &= !(1 << bit) });
-                    }
+                    })
                 />
             }
         })
@@ -203,7 +204,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         </div>
                         <h4>"Parameters"</h4>
                         <div class="form-row">
-                            <select on:change=move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2))>
+                            <select on:change=on_event(move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2)))>
                                 {plm_core::app::service::PROG_GROUPS.iter().enumerate().map(|(i, n)| view! {
                                     <option value=i.to_string() selected=i == 2>{*n}</option>
                                 }).map(IntoAny::into_any).collect_view()}

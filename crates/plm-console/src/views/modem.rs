@@ -10,6 +10,7 @@ use super::files;
 use super::widgets::{action_button, button};
 use crate::mibform::{self, Problems};
 use crate::stores::use_console;
+use super::widgets::on_event;
 use leptos::prelude::*;
 use plm_core::field::{Field, Kind};
 use plm_core::mib::Object;
@@ -151,7 +152,7 @@ fn Profiles() -> impl IntoView {
         {button("profile-save", "Save profile", "", save)}
         <label class="button">
             "Load profile…"
-            <input id="profile-load" type="file" accept=".json,application/json" on:change=load/>
+            <input id="profile-load" type="file" accept=".json,application/json" on:change=on_event(load)/>
         </label>
         {move || (running.get()).then(|| view! {
             {button("profile-cancel", "Cancel", "", move || cancel.set(true))}
@@ -334,7 +335,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                                     type="checkbox"
                                     data-action="reveal"
                                     prop:checked=move || reveal.get()
-                                    on:change=move |ev| reveal.set(event_target_checked(&ev))
+                                    on:change=on_event(move |ev| reveal.set(event_target_checked(&ev)))
                                 />
                                 " Reveal key"
                             </label>
@@ -455,7 +456,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
     };
     match field.kind {
         Kind::Enum(names) => view! {
-            <select name=name on:change=move |ev| set(event_target_value(&ev))>
+            <select name=name on:change=on_event(move |ev| set(event_target_value(&ev)))>
                 {names
                     .iter()
                     .enumerate()
@@ -478,7 +479,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                 type="checkbox"
                 name=name
                 prop:checked=move || value() == "1"
-                on:change=move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into())
+                on:change=on_event(move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into()))
             />
         }
         .into_any(),
@@ -491,7 +492,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                 spellcheck="false"
                 size="34"
                 prop:value=value
-                on:input=move |ev| set(event_target_value(&ev))
+                on:input=on_event(move |ev| set(event_target_value(&ev)))
             />
         }
         .into_any(),
@@ -502,7 +503,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                 name=name
                 size="10"
                 prop:value=value
-                on:input=move |ev| set(event_target_value(&ev))
+                on:input=on_event(move |ev| set(event_target_value(&ev)))
             />
         }
         .into_any(),

@@ -31,6 +31,7 @@ pub fn SerialPort() -> impl IntoView {
 
 #[cfg(target_arch = "wasm32")]
 mod wasm {
+    use crate::views::widgets::{on_click, on_event};
     use super::NO_WEB_SERIAL;
     use crate::stores::{use_console, Console};
     use crate::transport::webserial::{self, OnLost, Settings, TReqPolarity, WebSerialTransport};
@@ -340,7 +341,7 @@ mod wasm {
                         <select
                             id="serial-port"
                             style="flex: 1"
-                            on:change=move |ev| selected.set(event_target_value(&ev).parse().ok())
+                            on:change=on_event(move |ev| selected.set(event_target_value(&ev).parse().ok()))
                         >
                             {ports}
                         </select>
@@ -354,11 +355,11 @@ mod wasm {
                     </label>
                     <select
                         id="serial-baud"
-                        on:change=move |ev| {
+                        on:change=on_event(move |ev| {
                             if let Ok(b) = event_target_value(&ev).parse() {
                                 baud.set(b);
                             }
-                        }
+                        })
                     >
                         {bauds}
                     </select>
@@ -370,11 +371,11 @@ mod wasm {
                     </label>
                     <select
                         id="serial-polarity"
-                        on:change=move |ev| {
+                        on:change=on_event(move |ev| {
                             if let Some(p) = TReqPolarity::from_key(&event_target_value(&ev)) {
                                 polarity.set(p);
                             }
-                        }
+                        })
                     >
                         {polarities}
                     </select>
@@ -386,7 +387,7 @@ mod wasm {
                             type="checkbox"
                             id="serial-rts-twice"
                             prop:checked=move || rts_twice.get()
-                            on:change=move |ev| rts_twice.set(event_target_checked(&ev))
+                            on:change=on_event(move |ev| rts_twice.set(event_target_checked(&ev)))
                         />
                         " Send each RTS change twice (Windows)"
                     </label>
@@ -405,7 +406,7 @@ mod wasm {
                     aria-expanded=move || open.get().to_string()
                     aria-controls="serial-panel"
                     title=if supported { "Connect to a real modem over WebSerial" } else { NO_WEB_SERIAL }
-                    on:click=move |_| open.update(|o| *o = !*o)
+                    on:click=on_click(move |_| open.update(|o| *o = !*o))
                 >
                     {summary}
                 </button>
@@ -424,7 +425,7 @@ mod wasm {
                             <button
                                 id="serial-connect"
                                 disabled=move || busy.get() || labels.with(Vec::is_empty)
-                                on:click=move |_| chooser.connect()
+                                on:click=on_click(move |_| chooser.connect())
                             >
                                 {move || if active() { "Reconnect" } else { "Connect over WebSerial" }}
                             </button>
@@ -432,7 +433,7 @@ mod wasm {
                         <button
                             id="serial-use-sim"
                             disabled=move || console.conn.kind.get() == "Simulated"
-                            on:click=move |_| chooser.use_simulator()
+                            on:click=on_click(move |_| chooser.use_simulator())
                         >
                             "Use the simulated modem"
                         </button>

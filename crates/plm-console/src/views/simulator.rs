@@ -5,6 +5,7 @@
 use super::seconds;
 use super::widgets::button;
 use crate::stores::use_console;
+use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::st7580::fields::MODULATIONS;
 use plm_core::st7580::Temperature;
@@ -82,11 +83,11 @@ fn StreetCard() -> impl IntoView {
                 "Lamps "
                 <select
                     id="sim-lamps"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(n) = event_target_value(&ev).parse() {
                             choice.set(n);
                         }
-                    }
+                    })
                 >
                     {[6usize, 12, 50, 100, 500]
                         .into_iter()
@@ -160,11 +161,11 @@ fn TopologyCard() -> impl IntoView {
                 "Modems "
                 <select
                     id="sim-nodes"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(n) = event_target_value(&ev).parse() {
                             choice.set(n);
                         }
-                    }
+                    })
                 >
                     {[1usize, 2, 3, 5]
                         .into_iter()
@@ -206,9 +207,9 @@ fn ModemFaultsCard() -> impl IntoView {
                 {button("sim-watchdog", "Watchdog reset", "", move || inject(Fault::Watchdog))}
                 <button
                     id="sim-plug"
-                    on:click=move |_| {
+                    on:click=on_click(move |_| {
                         inject(if c.sim.plugged.get_untracked() { Fault::Unplug } else { Fault::Plug })
-                    }
+                    })
                 >
                     {move || if c.sim.plugged.get() { "Unplug the cable" } else { "Plug the cable in" }}
                 </button>
@@ -217,11 +218,11 @@ fn ModemFaultsCard() -> impl IntoView {
                 "Temperature "
                 <select
                     id="sim-temperature"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(t) = event_target_value(&ev).parse::<u8>() {
                             inject(Fault::Temperature(Temperature::from_bits(t)));
                         }
-                    }
+                    })
                 >
                     <option value="0" selected>"below 70 °C"</option>
                     <option value="1">"70-100 °C"</option>
@@ -330,9 +331,9 @@ fn UartCard() -> impl IntoView {
                 "Direction "
                 <select
                     id="sim-dir"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         dir.set(if event_target_value(&ev) == "up" { Dir::ModemToHost } else { Dir::HostToModem })
-                    }
+                    })
                 >
                     <option value="down" selected>"host → modem"</option>
                     <option value="up">"modem → host"</option>

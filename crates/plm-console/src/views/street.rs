@@ -7,6 +7,7 @@ use super::files::download;
 use super::widgets::{button, text_input};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
+use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::app::service::{Clock, Service};
 use plm_core::app::{Address, Message, Request};
@@ -70,14 +71,14 @@ pub fn StreetView() -> impl IntoView {
                                         type="checkbox"
                                         id="fleet-select-all"
                                         title="select every lamp shown"
-                                        on:change=move |ev| {
+                                        on:change=on_event(move |ev| {
                                             let on = event_target_checked(&ev);
                                             selected.set(if on {
                                                 rows.get_untracked().iter().map(|r| r.address).collect()
                                             } else {
                                                 Vec::new()
                                             });
-                                        }
+                                        })
                                     />
                                 </th>
                                 {COLUMNS
@@ -88,7 +89,7 @@ pub fn StreetView() -> impl IntoView {
                                             <th
                                                 class="sortable"
                                                 data-key=key
-                                                on:click=move |_| sort.update(|s| *s = (key, if s.0 == key { !s.1 } else { true }))
+                                                on:click=on_click(move |_| sort.update(|s| *s = (key, if s.0 == key { !s.1 } else { true })))
                                             >
                                                 {*header}
                                                 {move || match sort.get() {
@@ -117,19 +118,19 @@ pub fn StreetView() -> impl IntoView {
                                             data-address=address.to_string()
                                             class:trouble=move || row.with(|r| r.as_ref().is_some_and(|r| r.trouble))
                                             class:selected=move || focus.get() == Some(address)
-                                            on:click=move |_| focus.set(Some(address))
+                                            on:click=on_click(move |_| focus.set(Some(address)))
                                         >
-                                            <td on:click=|ev| ev.stop_propagation()>
+                                            <td on:click=on_click(|ev| ev.stop_propagation())>
                                                 <input
                                                     type="checkbox"
                                                     prop:checked=move || selected.with(|s| s.contains(&address))
-                                                    on:change=move |ev| {
+                                                    on:change=on_event(move |ev| {
                                                         let on = event_target_checked(&ev);
                                                         selected.update(|s| {
                                                             s.retain(|a| *a != address);
                                                             if on { s.push(address); }
                                                         });
-                                                    }
+                                                    })
                                                 />
                                             </td>
                                             {COLUMNS
@@ -182,10 +183,10 @@ fn SweepControl() -> impl IntoView {
                 type="checkbox"
                 id="street-sweep"
                 prop:checked=move || street.sweep.get().on
-                on:change=move |ev| {
+                on:change=on_event(move |ev| {
                     let on = event_target_checked(&ev);
                     street.act(|s| s.set_sweep(on));
-                }
+                })
             />
             " Poll the street"
         </label>
@@ -273,7 +274,7 @@ fn GroupActions(
             <button
                 id="street-dim-selected"
                 prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=move |_| dim(Some(selected.get_untracked()))
+                on:click=on_click(move |_| dim(Some(selected.get_untracked())))
             >
                 {move || format!("Dim selected ({})", selected.with(|s| s.len()))}
             </button>
@@ -282,7 +283,7 @@ fn GroupActions(
             <button
                 id="street-clock-selected"
                 prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     let c = computer_clock();
                     let list = selected.get_untracked();
                     let r = street.act(|s| {
@@ -294,7 +295,7 @@ fn GroupActions(
                         Ok(()) => format!("clock {c} sent to {} lamp(s)", list.len()),
                         Err(e) => format!("nothing sent: {e}"),
                     }));
-                }
+                })
             >
                 "Set clocks of selected"
             </button>
@@ -317,7 +318,7 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         let address = r.alert.address;
                         view! {
                             <li>
-                                <a href="#street" on:click=move |_| focus.set(Some(address))>{address.to_string()}</a>
+                                <a href="#street" on:click=on_click(move |_| focus.set(Some(address)))>{address.to_string()}</a>
                                 {format!(" {} (at {})", r.alert.what, r.wall)}
                             </li>
                         }

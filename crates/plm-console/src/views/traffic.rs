@@ -6,6 +6,7 @@ use super::widgets::button;
 use super::{seconds, spaced};
 use crate::stores::use_console;
 use crate::traffic::{Entry, Filter, CAPACITY};
+use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::st7580::code;
 use std::sync::Arc;
@@ -58,12 +59,12 @@ pub fn TrafficView() -> impl IntoView {
             <PauseButton/>
             <button
                 id="traffic-clear"
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     c.traffic.log.update(|l| l.clear());
                     c.traffic.paused_at.set(None);
                     selected.set(None);
                     message.set(None);
-                }
+                })
             >
                 "Clear"
             </button>
@@ -129,7 +130,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Way "
             <select
                 id="filter-from"
-                on:change=move |ev| filter.update(|f| f.from = event_target_value(&ev))
+                on:change=on_event(move |ev| filter.update(|f| f.from = event_target_value(&ev)))
             >
                 <option value="">"both"</option>
                 <option value="host">"host → modem"</option>
@@ -140,7 +141,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Kind "
             <select
                 id="filter-kind"
-                on:change=move |ev| filter.update(|f| f.kind = event_target_value(&ev))
+                on:change=on_event(move |ev| filter.update(|f| f.kind = event_target_value(&ev)))
             >
                 <option value="">"all"</option>
                 <option value="frame">"frames"</option>
@@ -154,7 +155,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Command "
             <select
                 id="filter-command"
-                on:change=move |ev| filter.update(|f| f.command = event_target_value(&ev))
+                on:change=on_event(move |ev| filter.update(|f| f.command = event_target_value(&ev)))
             >
                 <option value="">"all"</option>
                 {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).map(IntoAny::into_any).collect_view()}
@@ -171,14 +172,14 @@ fn PauseButton() -> impl IntoView {
         <button
             id="traffic-pause"
             aria-pressed=move || paused.get().is_some().to_string()
-            on:click=move |_| {
+            on:click=on_click(move |_| {
                 if paused.get_untracked().is_some() {
                     paused.set(None);
                 } else {
                     let last = c.traffic.log.with_untracked(|l| l.next_seq().saturating_sub(1));
                     paused.set(Some(last));
                 }
-            }
+            })
         >
             {move || if paused.get().is_some() { "Resume" } else { "Pause" }}
         </button>
@@ -245,7 +246,7 @@ fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
                 id="traffic-import"
                 type="file"
                 accept=".jsonl,.json,.txt,application/x-ndjson"
-                on:change=import
+                on:change=on_event(import)
             />
         </label>
     }
@@ -269,7 +270,7 @@ fn Row(entry: Arc<Entry>, selected: RwSignal<Option<u64>>) -> impl IntoView {
             class=format!("from-{from} kind-{}", entry.decoded.kind)
             class:bad=bad
             class:selected=move || selected.get() == Some(seq)
-            on:click=move |_| selected.set(Some(seq))
+            on:click=on_click(move |_| selected.set(Some(seq)))
         >
             <td class="num">{seq}</td>
             <td class="time">{entry.at.map(seconds).unwrap_or_else(|| "–".into())}</td>

@@ -10,6 +10,7 @@ use super::files::{chosen_file, download, download_bytes, read_bytes};
 use super::widgets::{button, note, text_input};
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
+use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::app::rfu::image::{self, Image};
 use plm_core::app::{Address, Release};
@@ -159,7 +160,7 @@ pub fn UpdateView() -> impl IntoView {
             <div class="toolbar">
                 <label>
                     "Image file "
-                    <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_file/>
+                    <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_event(on_file)/>
                 </label>
                 <span class="muted">"or make a simulated one: release "</span>
                 {text_input("update-make-release", "", "x.y", Some(5), make_release)}
@@ -181,14 +182,14 @@ pub fn UpdateView() -> impl IntoView {
             <div class="toolbar">
                 <label>
                     "Lamps "
-                    <select id="update-targets" on:change=move |ev| choice.set(event_target_value(&ev))>
+                    <select id="update-targets" on:change=on_event(move |ev| choice.set(event_target_value(&ev)))>
                         {move || target_options(street, choice)}
                     </select>
                 </label>
                 <button
                     id="update-start"
                     prop:disabled=move || running() == Some(true) || !chosen.with(|c| matches!(c, Some(Chosen { check: Ok(_), .. })))
-                    on:click=move |_| start()
+                    on:click=on_click(move |_| start())
                 >
                     "Start update"
                 </button>

@@ -35,7 +35,7 @@ fn button_boxed(
             id=(!id.is_empty()).then_some(id)
             data-action=(!action.is_empty()).then_some(action)
             title=(!title.is_empty()).then_some(title)
-            on:click=move |_| on()
+            on:click=on_click(move |_| on())
         >
             {label}
         </button>
@@ -59,7 +59,7 @@ pub fn text_input(
             placeholder=(!placeholder.is_empty()).then_some(placeholder)
             size=size
             prop:value=move || value.get()
-            on:input=move |ev| value.set(event_target_value(&ev))
+            on:input=on_event(move |ev| value.set(event_target_value(&ev)))
         />
     }
     .into_any()
@@ -95,4 +95,16 @@ type MakeRow = Arc<dyn Fn(u64) -> AnyView + Send + Sync>;
 #[inline(never)]
 fn keyed_rows_boxed(each: Keys, row: MakeRow) -> AnyView {
     view! { <For each=move || each() key=|k: &u64| *k children=move |k| row(k)/> }.into_any()
+}
+
+/// A `change` or `input` handler, boxed: tachys's event code is generic
+/// over the handler's type, so every `on:change=on_event(..)` of the page
+/// shares one instance of it instead of one per closure.
+pub fn on_event(f: impl FnMut(web_sys::Event) + 'static) -> Box<dyn FnMut(web_sys::Event)> {
+    Box::new(f)
+}
+
+/// A `click` handler, boxed (as [`on_event`]).
+pub fn on_click(f: impl FnMut(web_sys::MouseEvent) + 'static) -> Box<dyn FnMut(web_sys::MouseEvent)> {
+    Box::new(f)
 }
