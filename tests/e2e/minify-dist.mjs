@@ -1,6 +1,6 @@
 // Minifies the JavaScript of a release build in dist/ (the wasm-bindgen
-// glue and the service worker) with terser, gives the wasm's imports from
-// the glue short names (short-imports.mjs), and rewrites the Subresource
+// glue and the service worker) with terser, gives the wasm's imports and exports
+// between it and the glue short names (short-names.mjs), and rewrites the Subresource
 // Integrity hashes index.html gives for them. `cargo xtask dist` runs it
 // after Trunk: the console's 350 KiB budget counts every JS file, and
 // Trunk's own minifier leaves these two as they are. The sources keep
@@ -13,7 +13,7 @@ import fs from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { minify } from 'terser';
-import { shortenImports } from './short-imports.mjs';
+import { shortenImports } from './short-names.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const dist = path.resolve(process.argv[2] ?? path.join(here, '../../dist'));

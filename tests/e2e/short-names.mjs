@@ -1,4 +1,5 @@
-// Short names for the wasm's imports from its wasm-bindgen glue. Each
+// Short names for the wasm's imports from its wasm-bindgen glue and its
+// exports the glue calls (wasm.<name>). Each
 // import is named `__wbg_<method>_<16 hex digits>` in the wasm and as a key
 // of the glue's import object: a few hundred such names, whose hashes gzip
 // cannot shrink. minify-dist.mjs calls this on a release build; the names
@@ -35,10 +36,18 @@ function shortName(n) {
 const count = (text, s) => text.split(s).length - 1;
 
 /**
- * The wasm (a Buffer) and its glue (text) with short import names:
- * `{ wasm, js, renamed }`; both unchanged when there is nothing to rename.
+ * The wasm (a Buffer) and its glue (text) with short import and export
+ * names: `{ wasm, js, renamed }`; both unchanged when there is nothing to
+ * rename.
  */
 export function shortenImports(wasm, js) {
+  const imports = shortenImportSection(wasm, js);
+  const exports = shortenExports(wasm, imports.parts, imports.js, imports.fresh);
+  const renamed = imports.renamed + exports.renamed;
+  return renamed ? { wasm: Buffer.concat(exports.parts), js: exports.js, renamed } : { wasm, js, renamed };
+}
+
+function shortenImportSection(wasm, js) {
   let p = 8;
   const u32 = () => {
     let r = 0;
@@ -121,5 +130,52 @@ export function shortenImports(wasm, js) {
     parts.push(Buffer.from([2]), leb(section.length), section);
     p = end;
   }
-  return renamed ? { wasm: Buffer.concat(parts), js, renamed } : { wasm, js, renamed };
+  return { parts, js, renamed, used, fresh };
+}
+
+/**
+ * The exports the glue only ever names as `wasm.<name>` renamed in the
+ * export section (WebAssembly core spec 5.5.10) and in the glue.
+ */
+function shortenExports(wasm, parts, js, fresh) {
+  let renamed = 0;
+  const out = parts.map((part) => {
+    if (part[0] !== 7) return part;
+    let p = 1;
+    const u32 = () => {
+      let r = 0;
+      for (let shift = 0; ; shift += 7) {
+        const b = part[p++];
+        r += (b & 0x7f) * 2 ** shift;
+        if (!(b & 0x80)) return r;
+      }
+    };
+    u32(); // section size
+    const body = [];
+    const n = u32();
+    body.push(leb(n));
+    for (let i = 0; i < n; i++) {
+      const len = u32();
+      let field = part.toString('utf8', p, p + len);
+      p += len;
+      const descStart = p;
+      p++; // export kind
+      u32(); // index
+      // Whole names only (`x_16` is not `x`); the glue may also have a
+      // function of the same name (terser renames it), never a string.
+      const whole = (prefix) => new RegExp(`${prefix}${field}(?![\\w$])`, 'g');
+      const quoted = js.includes(`"${field}"`) || js.includes(`'${field}'`) || js.includes(`\`${field}`);
+      if (field.length > 2 && !quoted && whole('wasm\\.').test(js)) {
+        const s = fresh();
+        js = js.replace(whole('wasm\\.'), `wasm.${s}`);
+        field = s;
+        renamed++;
+      }
+      const f = Buffer.from(field);
+      body.push(leb(f.length), f, part.subarray(descStart, p));
+    }
+    const section = Buffer.concat(body);
+    return Buffer.concat([Buffer.from([7]), leb(section.length), section]);
+  });
+  return { parts: out, js, renamed };
 }
