@@ -169,7 +169,15 @@ fn DataRequestCard() -> impl IntoView {
         text: true,
         payload: "hello street".into(),
     });
-    let result = RwSignal::new(None::<Result<String, String>>);
+    // What came of it, and whether that is a problem: two signals of types
+    // the page has anyway rather than one `Option<Result<String, String>>`
+    // (each signal type brings its own code, docs/console.md "Size").
+    let result = RwSignal::new(None::<String>);
+    let problem = RwSignal::new(false);
+    let show = move |r: Result<String, String>| {
+        problem.set(r.is_err());
+        result.set(Some(r.unwrap_or_else(|e| e)));
+    };
     // The DL CRC length of MIB 00h (as last read, else its default) sets
     // how long a DL or SS payload may be (UM0932 Tables 3, 4, 53).
     let dl_crc_len = move || {
@@ -187,16 +195,16 @@ fn DataRequestCard() -> impl IntoView {
         let cmd = match build(&form.get_untracked(), dl_crc_len()) {
             Ok(cmd) => cmd,
             Err(why) => {
-                result.set(Some(Err(format!("nothing sent: {why}"))));
+                show(Err(format!("nothing sent: {why}")));
                 return;
             }
         };
-        result.set(Some(Ok(format!(
+        show(Ok(format!(
             "{} sent…",
             cmd.name().unwrap_or("request")
-        ))));
+        )));
         c.request(cmd, move |o| {
-            result.set(Some(match o {
+            show(match o {
                 Outcome::Answer {
                     command:
                         command @ (Command::PhyDataConfirm(_)
@@ -220,7 +228,7 @@ fn DataRequestCard() -> impl IntoView {
                     Err(refusal(&command).unwrap_or_else(|| crate::stores::unexpected(&command)))
                 }
                 Outcome::Failed(why) => Err(why),
-            }))
+            })
         });
     };
     let set = move |f: fn(&mut Form, String)| {
@@ -325,8 +333,8 @@ fn DataRequestCard() -> impl IntoView {
                 />
                 {super::widgets::button("data-send", "Send", "", send)}
             </div>
-            <p id="data-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
-                {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
+            <p id="data-result" class:problem=move || problem.get()>
+                {move || result.get()}
             </p>
         </article>
     }

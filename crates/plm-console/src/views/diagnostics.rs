@@ -54,27 +54,35 @@ fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoView {
 fn PingCard() -> impl IntoView {
     let c = use_console();
     let payload = RwSignal::new(String::from("50 4c 4d 21"));
-    let result = RwSignal::new(None::<Result<String, String>>);
+    // What came of it, and whether that is a problem: two signals of types
+    // the page has anyway rather than one `Option<Result<String, String>>`
+    // (each signal type brings its own code, docs/console.md "Size").
+    let result = RwSignal::new(None::<String>);
+    let problem = RwSignal::new(false);
+    let show = move |r: Result<String, String>| {
+        problem.set(r.is_err());
+        result.set(Some(r.unwrap_or_else(|e| e)));
+    };
     let history = RwSignal::new(Vec::<u64>::new());
     let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
             Ok(d) => {
-                result.set(Some(Err(format!(
+                show(Err(format!(
                     "nothing sent: a frame carries at most 255 bytes, not {}",
                     d.len()
-                ))));
+                )));
                 return;
             }
             Err(e) => {
-                result.set(Some(Err(format!("nothing sent: {e}"))));
+                show(Err(format!("nothing sent: {e}")));
                 return;
             }
         };
-        result.set(Some(Ok("sent, waiting for the answer…".into())));
+        show(Ok("sent, waiting for the answer…".into()));
         let sent = data.clone();
         c.request(Command::PingRequest { data }, move |o| {
-            result.set(Some(match o {
+            show(match o {
                 Outcome::Answer {
                     command: Command::PingConfirm { data },
                     rtt,
@@ -100,7 +108,7 @@ fn PingCard() -> impl IntoView {
                     Err(refusal(&command).unwrap_or_else(|| crate::stores::unexpected(&command)))
                 }
                 Outcome::Failed(why) => Err(why),
-            }))
+            })
         });
     };
     view! {
@@ -112,8 +120,8 @@ fn PingCard() -> impl IntoView {
                 {text_input("ping-payload", "hex", "", Some(30), payload)}
             </label>
             {button("ping-send", "Ping", "", ping)}
-            <p id="ping-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
-                {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
+            <p id="ping-result" class:problem=move || problem.get()>
+                {move || result.get()}
             </p>
             <p class="muted" id="ping-history">
                 {move || {
