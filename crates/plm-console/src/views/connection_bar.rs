@@ -2,10 +2,10 @@
 //! (the profile), state, transport (with the WebSerial port chooser) and
 //! port, baud, T_REQ level, the link's repeats and its timeouts.
 
+use super::widgets::{on_click, on_event};
 use crate::profile::Profile;
 use crate::stores::use_console;
 use crate::transport::LinkState;
-use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_sim::BAUD_RATES;
 

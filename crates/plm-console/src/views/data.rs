@@ -4,11 +4,11 @@
 //! indications) as plm-core decoded them in the traffic log.
 
 use super::snr_plot::{self, Point};
+use super::widgets::on_event;
 use super::{millis, seconds, spaced};
 use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;
-use super::widgets::on_event;
 use leptos::prelude::*;
 use plm_core::json::Json;
 use plm_core::st7580::fields::{confirm_data, tx_options, MODULATIONS};
@@ -199,10 +199,7 @@ fn DataRequestCard() -> impl IntoView {
                 return;
             }
         };
-        show(Ok(format!(
-            "{} sent…",
-            cmd.name().unwrap_or("request")
-        )));
+        show(Ok(format!("{} sent…", cmd.name().unwrap_or("request"))));
         c.request(cmd, move |o| {
             show(match o {
                 Outcome::Answer {

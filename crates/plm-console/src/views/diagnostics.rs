@@ -2,11 +2,10 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
-use super::widgets::{action_button, button, note, text_input};
+use super::widgets::{action_button, button, note, on_click, on_event, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
-use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::field::Field;
 use plm_core::st7580::fields::{reset_data, status};

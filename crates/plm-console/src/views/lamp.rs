@@ -3,10 +3,9 @@
 //! ballast reset, and on a simulated street the faults a demo needs.
 
 use super::street::{computer_clock, dimming_value};
-use super::widgets::{button, text_input};
+use super::widgets::{button, on_event, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
-use super::widgets::on_event;
 use leptos::prelude::*;
 use plm_core::app::service::Service;
 use plm_core::app::{Address, Message, Request};

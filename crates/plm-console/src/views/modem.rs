@@ -7,10 +7,9 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
-use super::widgets::{action_button, button};
+use super::widgets::{action_button, button, on_event};
 use crate::mibform::{self, Problems};
 use crate::stores::use_console;
-use super::widgets::on_event;
 use leptos::prelude::*;
 use plm_core::field::{Field, Kind};
 use plm_core::mib::Object;

@@ -31,11 +31,11 @@ pub fn SerialPort() -> impl IntoView {
 
 #[cfg(target_arch = "wasm32")]
 mod wasm {
-    use crate::views::widgets::{on_click, on_event};
     use super::NO_WEB_SERIAL;
     use crate::stores::{use_console, Console};
     use crate::transport::webserial::{self, OnLost, Settings, TReqPolarity, WebSerialTransport};
     use crate::transport::LinkState;
+    use crate::views::widgets::{on_click, on_event};
     use leptos::prelude::*;
     use plm_sim::BAUD_RATES;
     use std::rc::Rc;

@@ -3,9 +3,8 @@
 //! UART byte faults, modem reset and unplug, and what happens on the line.
 
 use super::seconds;
-use super::widgets::button;
+use super::widgets::{button, on_click, on_event};
 use crate::stores::use_console;
-use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::st7580::fields::MODULATIONS;
 use plm_core::st7580::Temperature;

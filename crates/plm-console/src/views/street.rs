@@ -4,10 +4,9 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
-use super::widgets::{button, text_input};
+use super::widgets::{button, on_click, on_event, text_input};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
-use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::app::service::{Clock, Service};
 use plm_core::app::{Address, Message, Request};
@@ -329,19 +328,6 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn dimming_values_must_be_numbers() {
-        assert_eq!(dimming_value(" 40 "), Ok(40));
-        assert!(dimming_value("4o")
-            .unwrap_err()
-            .contains("not a dimming value"));
-    }
-}
-
 /// A board address as the key of its row (6 bytes in a u64), and back.
 fn row_key(a: Address) -> u64 {
     let mut k = [0; 8];
@@ -353,4 +339,33 @@ fn key_address(key: u64) -> Address {
     let mut a = [0; 6];
     a.copy_from_slice(&key.to_be_bytes()[2..]);
     Address(a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dimming_values_must_be_numbers() {
+        assert_eq!(dimming_value(" 40 "), Ok(40));
+        assert!(dimming_value("4o")
+            .unwrap_err()
+            .contains("not a dimming value"));
+    }
+
+    #[test]
+    fn a_row_key_gives_its_address_back() {
+        for a in [
+            Address([0; 6]),
+            Address([0x00, 0x80, 0xE1, 0x00, 0x00, 0x01]),
+            Address::BROADCAST,
+        ] {
+            assert_eq!(key_address(row_key(a)), a);
+        }
+        // Distinct addresses, distinct rows.
+        assert_ne!(
+            row_key(Address([0, 0, 0, 0, 0, 1])),
+            row_key(Address([1, 0, 0, 0, 0, 0]))
+        );
+    }
 }

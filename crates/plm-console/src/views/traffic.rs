@@ -2,11 +2,10 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
-use super::widgets::button;
+use super::widgets::{button, on_click, on_event};
 use super::{seconds, spaced};
 use crate::stores::use_console;
 use crate::traffic::{Entry, Filter, CAPACITY};
-use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::st7580::code;
 use std::sync::Arc;

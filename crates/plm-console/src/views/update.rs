@@ -7,10 +7,9 @@
 //! from what the browser kept; the results export as CSV.
 
 use super::files::{chosen_file, download, download_bytes, read_bytes};
-use super::widgets::{button, note, text_input};
+use super::widgets::{button, note, on_click, on_event, text_input};
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
-use super::widgets::{on_click, on_event};
 use leptos::prelude::*;
 use plm_core::app::rfu::image::{self, Image};
 use plm_core::app::{Address, Release};

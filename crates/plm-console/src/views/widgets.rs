@@ -18,7 +18,11 @@ pub fn button(
 
 /// A button of a card's actions, named by `data-action` (`read`, `erase`,
 /// ...) as each card has its own.
-pub fn action_button(action: &'static str, label: &'static str, on: impl Fn() + 'static) -> AnyView {
+pub fn action_button(
+    action: &'static str,
+    label: &'static str,
+    on: impl Fn() + 'static,
+) -> AnyView {
     button_boxed("", action, label, "", Box::new(on))
 }
 
@@ -105,6 +109,8 @@ pub fn on_event(f: impl FnMut(web_sys::Event) + 'static) -> Box<dyn FnMut(web_sy
 }
 
 /// A `click` handler, boxed (as [`on_event`]).
-pub fn on_click(f: impl FnMut(web_sys::MouseEvent) + 'static) -> Box<dyn FnMut(web_sys::MouseEvent)> {
+pub fn on_click(
+    f: impl FnMut(web_sys::MouseEvent) + 'static,
+) -> Box<dyn FnMut(web_sys::MouseEvent)> {
     Box::new(f)
 }
