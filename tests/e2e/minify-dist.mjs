@@ -1,7 +1,7 @@
 // Minifies the JavaScript of a release build in dist/ (the wasm-bindgen
-// glue and the service worker) with terser, gives the wasm's imports and exports
-// between it and the glue short names (short-names.mjs), and rewrites the Subresource
-// Integrity hashes index.html gives for them. `cargo xtask dist` runs it
+// glue and the service worker) with terser, gives the wasm's imports and
+// exports between it and the glue short names (short-names.mjs), and
+// rewrites the Subresource Integrity hashes index.html gives for them. `cargo xtask dist` runs it
 // after Trunk: the console's 350 KiB budget counts every JS file, and
 // Trunk's own minifier leaves these two as they are. The sources keep
 // their comments; only the copies the browser downloads are minified.
@@ -13,7 +13,7 @@ import fs from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { minify } from 'terser';
-import { shortenImports } from './short-names.mjs';
+import { shortenNames } from './short-names.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const dist = path.resolve(process.argv[2] ?? path.join(here, '../../dist'));
@@ -29,7 +29,7 @@ for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sor
   const wasmFile = path.join(dist, name.replace(/\.js$/, '_bg.wasm'));
   const wasm = module ? await fs.readFile(wasmFile).catch(() => null) : null;
   if (wasm) {
-    const short = shortenImports(wasm, before);
+    const short = shortenNames(wasm, before);
     before = short.js;
     await fs.writeFile(wasmFile, short.wasm);
     const oldWasm = sri(wasm);

@@ -1,14 +1,16 @@
-// Short names for the wasm's imports from its wasm-bindgen glue and its
-// exports the glue calls (wasm.<name>). Each
-// import is named `__wbg_<method>_<16 hex digits>` in the wasm and as a key
-// of the glue's import object: a few hundred such names, whose hashes gzip
-// cannot shrink. minify-dist.mjs calls this on a release build; the names
-// mean nothing to anyone (they are the glue's private link to the wasm).
+// Short names for the wasm's imports from its wasm-bindgen glue and for
+// its exports the glue calls (`wasm.<name>`). Each import is named
+// `__wbg_<method>_<16 hex digits>` in the wasm and as a key of the glue's
+// import object, closure trampolines are exported with a hash too: a few
+// hundred such names, whose hashes gzip cannot shrink. minify-dist.mjs
+// calls this on a release build; the names mean nothing to anyone (they
+// are the glue's private link to the wasm).
 //
 // The wasm's import section is rewritten (WebAssembly core spec 5.5.5:
 // module name, field name, import description) and every name in the glue
 // with it. A name is only renamed when the glue holds it exactly once, as
-// a key (`name:`); the module name only when the glue names it once.
+// a key (`name:`); the module name only when the glue names it once; an
+// export (5.5.10) only when the glue never writes it in quotes.
 
 /** Unsigned LEB128 (WebAssembly core spec 5.2.2). */
 function leb(n) {
@@ -40,9 +42,9 @@ const count = (text, s) => text.split(s).length - 1;
  * names: `{ wasm, js, renamed }`; both unchanged when there is nothing to
  * rename.
  */
-export function shortenImports(wasm, js) {
+export function shortenNames(wasm, js) {
   const imports = shortenImportSection(wasm, js);
-  const exports = shortenExports(wasm, imports.parts, imports.js, imports.fresh);
+  const exports = shortenExports(imports.parts, imports.js, imports.fresh);
   const renamed = imports.renamed + exports.renamed;
   return renamed ? { wasm: Buffer.concat(exports.parts), js: exports.js, renamed } : { wasm, js, renamed };
 }
@@ -137,7 +139,7 @@ function shortenImportSection(wasm, js) {
  * The exports the glue only ever names as `wasm.<name>` renamed in the
  * export section (WebAssembly core spec 5.5.10) and in the glue.
  */
-function shortenExports(wasm, parts, js, fresh) {
+function shortenExports(parts, js, fresh) {
   let renamed = 0;
   const out = parts.map((part) => {
     if (part[0] !== 7) return part;
