@@ -16,7 +16,9 @@ use plm_core::app::{Address, Message, Request};
 pub fn StreetView() -> impl IntoView {
     let street = use_console().street;
     let filter = RwSignal::new(String::new());
-    let sort = RwSignal::new(("address", true));
+    // The column sorted by, `-` before it when descending: a String signal
+    // as the page has many, not one of its own type (docs/console.md, "Size").
+    let sort = RwSignal::new(String::from("address"));
     let selected = street.selected;
     let focus = RwSignal::new(None::<Address>);
     let message = RwSignal::new(None::<String>);
@@ -28,8 +30,10 @@ pub fn StreetView() -> impl IntoView {
         let now = street.now.get();
         let mut rows: Vec<Row> =
             street.with_fleet(|f| f.values().map(|l| Row::of(l, now)).collect());
-        let (key, asc) = sort.get();
-        fleet::sort(&mut rows, key, asc);
+        sort.with(|s| match s.strip_prefix('-') {
+            Some(key) => fleet::sort(&mut rows, key, false),
+            None => fleet::sort(&mut rows, s, true),
+        });
         let f = filter.get();
         rows.retain(|r| r.matches(&f));
         rows
@@ -88,14 +92,18 @@ pub fn StreetView() -> impl IntoView {
                                             <th
                                                 class="sortable"
                                                 data-key=key
-                                                on:click=on_click(move |_| sort.update(|s| *s = (key, if s.0 == key { !s.1 } else { true })))
+                                                on:click=on_click(move |_| sort.update(|s| *s = if s == key { format!("-{key}") } else { key.to_string() }))
                                             >
                                                 {*header}
-                                                {move || match sort.get() {
-                                                    (k, true) if k == key => " ▲",
-                                                    (k, false) if k == key => " ▼",
-                                                    _ => "",
-                                                }}
+                                                {move || sort.with(|s| {
+                                                    if s == key {
+                                                        " ▲"
+                                                    } else if s.strip_prefix('-') == Some(key) {
+                                                        " ▼"
+                                                    } else {
+                                                        ""
+                                                    }
+                                                })}
                                             </th>
                                         }
                                     })
