@@ -115,7 +115,7 @@ pub fn ConnectionBar() -> impl IntoView {
                         )
                     }
                 >
-                    "Repeats " <b>{move || conn.retries.get()}</b>
+                    "Repeats " <b>{move || conn.retries.get().to_string()}</b>
                 </span>
             }).map(IntoAny::into_any)}
             <span class="item muted" title="Host-interface timeouts (ST7580 MIB 09h; ST7570: T_IC from 000Bh)" hidden=move || !modem()>
