@@ -86,7 +86,7 @@ pub fn TrafficView() -> impl IntoView {
                         s
                     })
             }}
-            {move || c.traffic.paused_at.get().map(|_| " · PAUSED")}
+            {move || c.traffic.paused_at.get().map(|_| " · PAUSED".to_string())}
         </p>
         {move || message.get().map(|m| view! { <p class="message" id="traffic-message">{m}</p> })}
         <div class="traffic">
