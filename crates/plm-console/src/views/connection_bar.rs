@@ -49,7 +49,7 @@ pub fn ConnectionBar() -> impl IntoView {
                     LinkState::Disconnected(why) => why,
                 }
             >
-                {move || if connected() { "● Connected" } else { "○ Disconnected" }}
+                {move || String::from(if connected() { "● Connected" } else { "○ Disconnected" })}
             </span>
             <span
                 class="item"
@@ -91,17 +91,17 @@ pub fn ConnectionBar() -> impl IntoView {
                 </select>
             </label>
             <span class="item">
-                {move || if profile.get() == Profile::StreetBoard { "Board " } else { "Chip " }}
-                <b id="conn-chip">{move || match profile.get() {
+                {move || String::from(if profile.get() == Profile::StreetBoard { "Board " } else { "Chip " })}
+                <b id="conn-chip">{move || String::from(match profile.get() {
                     Profile::StreetBoard => "STEVAL-IHP007V1 USART",
                     Profile::St7570 => "ST7570",
                     _ => "ST7580",
-                }}</b>
+                })}</b>
             </span>
             <span class="item" id="conn-treq" title="T_REQ: low = the host asks to send" hidden=move || !modem()>
                 "T_REQ "
                 <b class:low=move || conn.treq.get()>
-                    {move || if conn.treq.get() { "low" } else { "high" }}
+                    {move || String::from(if conn.treq.get() { "low" } else { "high" })}
                 </b>
             </span>
             {move || (conn.retries.get() != 0).then(|| view! {
@@ -141,7 +141,7 @@ pub fn ConnectionBar() -> impl IntoView {
                     }
                 })
             >
-                {move || if conn.kind.get().is_empty() { "Connect" } else { "Disconnect" }}
+                {move || String::from(if conn.kind.get().is_empty() { "Connect" } else { "Disconnect" })}
             </button>
         </div>
     }

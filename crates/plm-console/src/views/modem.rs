@@ -74,10 +74,10 @@ pub fn ModemView() -> impl IntoView {
             <span class="muted" id="mib-progress">{move || progress.get()}</span>
             <Profiles/>
             <span class="muted">
-                {move || match objects.get().1 {
+                {move || String::from(match objects.get().1 {
                     plm_core::link::Dialect::St7580 => "ST7580 MIB (UM0932 4, Table 52).",
                     plm_core::link::Dialect::St7570 => "ST7570 MIB (ST7570 UM 6, Table 71).",
-                }}
+                })}
                 " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>

@@ -427,7 +427,7 @@ mod wasm {
                                 disabled=move || busy.get() || labels.with(Vec::is_empty)
                                 on:click=on_click(move |_| chooser.connect())
                             >
-                                {move || if active() { "Reconnect" } else { "Connect over WebSerial" }}
+                                {move || String::from(if active() { "Reconnect" } else { "Connect over WebSerial" })}
                             </button>
                         }).map(IntoAny::into_any)}
                         <button

@@ -210,7 +210,7 @@ fn ModemFaultsCard() -> impl IntoView {
                         inject(if c.sim.plugged.get_untracked() { Fault::Unplug } else { Fault::Plug })
                     })
                 >
-                    {move || if c.sim.plugged.get() { "Unplug the cable" } else { "Plug the cable in" }}
+                    {move || String::from(if c.sim.plugged.get() { "Unplug the cable" } else { "Plug the cable in" })}
                 </button>
             </div>
             <label>

@@ -95,7 +95,7 @@ pub fn StreetView() -> impl IntoView {
                                                 on:click=on_click(move |_| sort.update(|s| *s = if s == key { format!("-{key}") } else { key.to_string() }))
                                             >
                                                 {*header}
-                                                {move || sort.with(|s| {
+                                                {move || String::from(sort.with(|s| {
                                                     if s == key {
                                                         " ▲"
                                                     } else if s.strip_prefix('-') == Some(key) {
@@ -103,7 +103,7 @@ pub fn StreetView() -> impl IntoView {
                                                     } else {
                                                         ""
                                                     }
-                                                })}
+                                                }))}
                                             </th>
                                         }
                                     })
@@ -165,11 +165,11 @@ pub fn StreetView() -> impl IntoView {
                     </table>
                     {move || (rows.with(|r| r.is_empty())).then(|| view! {
                         <p class="muted empty">
-                            {move || if street.discovering.get().is_some() {
+                            {move || String::from(if street.discovering.get().is_some() {
                                 "Looking for lamps on the line…"
                             } else {
                                 "No lamp matches. Discover finds the lamps on the line."
-                            }}
+                            })}
                         </p>
                     }).map(IntoAny::into_any)}
                 </div>

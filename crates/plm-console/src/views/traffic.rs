@@ -180,7 +180,7 @@ fn PauseButton() -> impl IntoView {
                 }
             })
         >
-            {move || if paused.get().is_some() { "Resume" } else { "Pause" }}
+            {move || String::from(if paused.get().is_some() { "Resume" } else { "Pause" })}
         </button>
     }
 }
