@@ -15,7 +15,7 @@
 // (and WebSerial, which is no fetch at all) passes by untouched.
 
 // Bump when this file's caching changes: activate deletes every other cache.
-const VERSION = 'v1';
+const VERSION = 'v2';
 const PREFIX = 'plm-console-';
 const CACHE = `${PREFIX}${VERSION}`;
 
@@ -104,9 +104,13 @@ async function remember(cache, response) {
   const linked = new Set();
   // Trunk writes `href="./x"`, `src="./x"` and, in its loader script,
   // `'./x.js'` / `'./x_bg.wasm'`; all relative, as `public_url = "./"`.
+  // A release build's HTML is minified (Trunk.toml), which drops the quotes
+  // where HTML allows it (`href=./style-<hash>.css`): an unquoted value runs
+  // to the next space or `>` (HTML 13.1.2.3, unquoted attribute value).
   // (STABLE and this worker, registered from index.html too, are apart.)
-  for (const m of html.matchAll(/(?:href|src)\s*=\s*"([^"]+)"|'(\.\/[^']+)'/g)) {
-    const href = new URL(m[1] ?? m[2], scopeUrl('./'));
+  const attribute = /(?:href|src)\s*=\s*(?:"([^"]+)"|([^\s"'=<>`]+))|'(\.\/[^']+)'/g;
+  for (const m of html.matchAll(attribute)) {
+    const href = new URL(m[1] ?? m[2] ?? m[3], scopeUrl('./'));
     href.hash = '';
     const ours = href.origin === self.location.origin;
     if (ours && href.href !== self.location.href && !stable.includes(href.href)) {

@@ -37,6 +37,19 @@ before(async () => {
   browser = await launchChromium();
 });
 
+/**
+ * Polls `fn(arg)` in the page until it is truthy, for up to 15 s. Not
+ * `page.waitForFunction`: it takes the Promise an async function returns
+ * for a truthy value and resolves at once, whatever the Promise holds.
+ */
+async function until(page, fn, arg, what) {
+  const end = Date.now() + 15_000;
+  while (!(await page.evaluate(fn, arg))) {
+    if (Date.now() > end) throw new Error(`timed out waiting: ${what}`);
+    await new Promise((r) => setTimeout(r, 200));
+  }
+}
+
 after(async () => {
   await browser?.close();
   if (server?.listening) {
@@ -71,13 +84,14 @@ test('once visited, the console works offline, and it is installable', async (t)
     return urls;
   });
   assert.ok(linked.some((u) => u.endsWith('_bg.wasm')), linked.join(', '));
-  await page.waitForFunction(
+  await until(
+    page,
     async (urls) => {
       for (const u of urls) if (!(await caches.match(u))) return false;
       return true;
     },
     linked.filter((u) => !u.endsWith('/sw.js')),
-    { timeout: 15_000, polling: 200 },
+    'every linked file cached',
   );
 
   // The manifest: linked, served, parsed by Chromium as we mean it.
@@ -115,10 +129,11 @@ test('once visited, the console works offline, and it is installable', async (t)
   await page.reload();
   await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
   assert.equal(await page.locator('meta[name=plm-build][content=second]').count(), 1);
-  await page.waitForFunction(
+  await until(
+    page,
     async () => (await (await caches.match('./index.html'))?.text())?.includes('plm-build'),
     null,
-    { timeout: 15_000, polling: 200 },
+    'the new build cached',
   );
 
   // Offline: no network for the page, and no server at all any more.

@@ -59,6 +59,29 @@ test('the page opens on the simulated street: every lamp found, read and lit', a
   await shot(page, 'street');
 });
 
+test('a column header sorts the fleet table by it, the other way on a second click', async (t) => {
+  const page = await open(t);
+  const header = page.locator('#fleet-table th[data-key="address"]');
+  const addresses = () =>
+    page.$$eval('#fleet-table tbody tr', (rows) => rows.map((r) => r.dataset.address));
+  const ascending = Array.from({ length: LAMPS }, (_, i) => lamp(i + 1));
+  // The table opens sorted by address, ascending.
+  assert.deepEqual(await addresses(), ascending);
+  assert.match(await header.textContent(), /▲$/);
+  await header.click();
+  await page.waitForFunction((first) => document.querySelector('#fleet-table tbody tr').dataset.address === first, lamp(LAMPS));
+  assert.deepEqual(await addresses(), [...ascending].reverse());
+  assert.match(await header.textContent(), /▼$/);
+  await header.click();
+  await page.waitForFunction((first) => document.querySelector('#fleet-table tbody tr').dataset.address === first, lamp(1));
+  assert.deepEqual(await addresses(), ascending);
+  // Another column takes the sort, ascending; the address loses its arrow.
+  const firmware = page.locator('#fleet-table th[data-key="firmware"]');
+  await firmware.click();
+  await page.waitForFunction(() => document.querySelector('#fleet-table th[data-key="firmware"]').textContent.endsWith('▲'));
+  assert.doesNotMatch(await header.textContent(), /[▲▼]/);
+});
+
 test('dim one lamp and see its power follow; dim all by broadcast', async (t) => {
   const page = await open(t);
   const before3 = await number(page, 3, 'power');

@@ -162,7 +162,7 @@ pub fn App() -> impl IntoView {
                             </a>
                         }
                     })
-                    .collect_view()}
+                    .map(IntoAny::into_any).collect_view()}
             </nav>
             </div>
             <main>
@@ -218,7 +218,10 @@ fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
 
 /// A view of what only the ST7580 has: shown unless the ST7570 profile
 /// is chosen, when the ST7570's counterpart (`st7570`) shows instead, or
-/// where to find it.
+/// where to find it. A memo of the choice rather than `<Show>` (one more
+/// generic component in the page, docs/console.md "Size"); like
+/// `<Show>`, the view is only made anew when the choice changes, so its
+/// form state survives a change between the ST7580 profiles.
 #[component]
 fn St7580Only(
     what: &'static str,
@@ -226,23 +229,22 @@ fn St7580Only(
     children: ChildrenFn,
 ) -> impl IntoView {
     let console = use_console();
-    let chosen = move || console.profile.get() == Profile::St7570;
-    view! {
-        <Show
-            when=move || !chosen()
-            fallback=move || match st7570 {
-                Some(view) => view(),
-                None => view! {
-                    <article class="card">
-                        <p class="muted">
-                            {format!("These ST7580 {what} do not apply to the ST7570. Its MIB is in the Modem view, its network in Network and its frames, decoded in its access layer, in Traffic.")}
-                        </p>
-                    </article>
-                }.into_any(),
+    let chosen = Memo::new(move |_| console.profile.get() == Profile::St7570);
+    move || {
+        if !chosen.get() {
+            children().into_any()
+        } else if let Some(view) = st7570 {
+            view()
+        } else {
+            view! {
+                <article class="card">
+                    <p class="muted">
+                        {format!("These ST7580 {what} do not apply to the ST7570. Its MIB is in the Modem view, its network in Network and its frames, decoded in its access layer, in Traffic.")}
+                    </p>
+                </article>
             }
-        >
-            {children()}
-        </Show>
+            .into_any()
+        }
     }
 }
 
@@ -257,10 +259,10 @@ fn LinkProblem() -> impl IntoView {
         {move || text().map(|t| view! {
             <div class="toast" role="status" id="link-problem">
                 <span>{t}</span>
-                <button on:click=move |_| {
+                {crate::views::widgets::button("", "Dismiss", "", move || {
                     advice.set(None);
                     problem.set(None);
-                }>"Dismiss"</button>
+                })}
             </div>
         })}
     }

@@ -2,6 +2,7 @@
 //! (the profile), state, transport (with the WebSerial port chooser) and
 //! port, baud, T_REQ level, the link's repeats and its timeouts.
 
+use super::widgets::{on_click, on_event};
 use crate::profile::Profile;
 use crate::stores::use_console;
 use crate::transport::LinkState;
@@ -21,11 +22,11 @@ pub fn ConnectionBar() -> impl IntoView {
             <label title="What is at the other end of the serial port. Changing it restarts the simulated world (or reconnects the port with the new profile).">
                 <select
                     id="profile"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Some(p) = Profile::from_key(&event_target_value(&ev)) {
                             c.set_profile(p);
                         }
-                    }
+                    })
                 >
                     {Profile::ALL
                         .into_iter()
@@ -36,7 +37,7 @@ pub fn ConnectionBar() -> impl IntoView {
                                 </option>
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
             <span
@@ -48,7 +49,7 @@ pub fn ConnectionBar() -> impl IntoView {
                     LinkState::Disconnected(why) => why,
                 }
             >
-                {move || if connected() { "● Connected" } else { "○ Disconnected" }}
+                {move || String::from(if connected() { "● Connected" } else { "○ Disconnected" })}
             </span>
             <span
                 class="item"
@@ -71,11 +72,11 @@ pub fn ConnectionBar() -> impl IntoView {
                 "Baud "
                 <select
                     id="baud"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(b) = event_target_value(&ev).parse::<u32>() {
                             c.set_baud(b);
                         }
-                    }
+                    })
                 >
                     {BAUD_RATES
                         .iter()
@@ -86,21 +87,21 @@ pub fn ConnectionBar() -> impl IntoView {
                                 </option>
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
             <span class="item">
-                {move || if profile.get() == Profile::StreetBoard { "Board " } else { "Chip " }}
-                <b id="conn-chip">{move || match profile.get() {
+                {move || String::from(if profile.get() == Profile::StreetBoard { "Board " } else { "Chip " })}
+                <b id="conn-chip">{move || String::from(match profile.get() {
                     Profile::StreetBoard => "STEVAL-IHP007V1 USART",
                     Profile::St7570 => "ST7570",
                     _ => "ST7580",
-                }}</b>
+                })}</b>
             </span>
             <span class="item" id="conn-treq" title="T_REQ: low = the host asks to send" hidden=move || !modem()>
                 "T_REQ "
                 <b class:low=move || conn.treq.get()>
-                    {move || if conn.treq.get() { "low" } else { "high" }}
+                    {move || String::from(if conn.treq.get() { "low" } else { "high" })}
                 </b>
             </span>
             {move || (conn.retries.get() != 0).then(|| view! {
@@ -114,9 +115,9 @@ pub fn ConnectionBar() -> impl IntoView {
                         )
                     }
                 >
-                    "Repeats " <b>{move || conn.retries.get()}</b>
+                    "Repeats " <b>{move || conn.retries.get().to_string()}</b>
                 </span>
-            })}
+            }).map(IntoAny::into_any)}
             <span class="item muted" title="Host-interface timeouts (ST7580 MIB 09h; ST7570: T_IC from 000Bh)" hidden=move || !modem()>
                 {move || {
                     let t = conn.timeouts.get();
@@ -132,15 +133,15 @@ pub fn ConnectionBar() -> impl IntoView {
             </span>
             <button
                 id="connect"
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     if c.conn.kind.get_untracked().is_empty() {
                         c.connect_simulated();
                     } else {
                         c.disconnect();
                     }
-                }
+                })
             >
-                {move || if conn.kind.get().is_empty() { "Connect" } else { "Disconnect" }}
+                {move || String::from(if conn.kind.get().is_empty() { "Connect" } else { "Disconnect" })}
             </button>
         </div>
     }

@@ -4,6 +4,7 @@
 //! indications) as plm-core decoded them in the traffic log.
 
 use super::snr_plot::{self, Point};
+use super::widgets::on_event;
 use super::{millis, seconds, spaced};
 use crate::app::Tab;
 use crate::session::Outcome;
@@ -169,7 +170,15 @@ fn DataRequestCard() -> impl IntoView {
         text: true,
         payload: "hello street".into(),
     });
-    let result = RwSignal::new(None::<Result<String, String>>);
+    // What came of it, and whether that is a problem: two signals of types
+    // the page has anyway rather than one `Option<Result<String, String>>`
+    // (each signal type brings its own code, docs/console.md "Size").
+    let result = RwSignal::new(None::<String>);
+    let problem = RwSignal::new(false);
+    let show = move |r: Result<String, String>| {
+        problem.set(r.is_err());
+        result.set(Some(r.unwrap_or_else(|e| e)));
+    };
     // The DL CRC length of MIB 00h (as last read, else its default) sets
     // how long a DL or SS payload may be (UM0932 Tables 3, 4, 53).
     let dl_crc_len = move || {
@@ -183,20 +192,17 @@ fn DataRequestCard() -> impl IntoView {
             .unwrap_or_default();
         [1, 2, 4, 4][ModemConfig::decode(&data).crc_length as usize & 3]
     };
-    let send = move |_| {
+    let send = move || {
         let cmd = match build(&form.get_untracked(), dl_crc_len()) {
             Ok(cmd) => cmd,
             Err(why) => {
-                result.set(Some(Err(format!("nothing sent: {why}"))));
+                show(Err(format!("nothing sent: {why}")));
                 return;
             }
         };
-        result.set(Some(Ok(format!(
-            "{} sent…",
-            cmd.name().unwrap_or("request")
-        ))));
+        show(Ok(format!("{} sent…", cmd.name().unwrap_or("request"))));
         c.request(cmd, move |o| {
-            result.set(Some(match o {
+            show(match o {
                 Outcome::Answer {
                     command:
                         command @ (Command::PhyDataConfirm(_)
@@ -220,7 +226,7 @@ fn DataRequestCard() -> impl IntoView {
                     Err(refusal(&command).unwrap_or_else(|| crate::stores::unexpected(&command)))
                 }
                 Outcome::Failed(why) => Err(why),
-            }))
+            })
         });
     };
     let set = move |f: fn(&mut Form, String)| {
@@ -235,7 +241,7 @@ fn DataRequestCard() -> impl IntoView {
             <div class="form-row">
                 <label>
                     "Layer "
-                    <select id="data-layer" on:change=set(|f, v| f.layer = v)>
+                    <select id="data-layer" on:change=on_event(set(|f, v| f.layer = v))>
                         <option value="phy">"PHY"</option>
                         <option value="dl" selected>"DL"</option>
                         <option value="ss">"SS"</option>
@@ -243,18 +249,18 @@ fn DataRequestCard() -> impl IntoView {
                 </label>
                 <label>
                     "Modulation "
-                    <select id="data-modulation" on:change=set(|f, v| f.modulation = v)>
+                    <select id="data-modulation" on:change=on_event(set(|f, v| f.modulation = v))>
                         {MODULATIONS
                             .iter()
                             .enumerate()
                             .filter(|(_, n)| **n != "Reserved")
                             .map(|(i, n)| view! { <option value=i.to_string()>{*n}</option> })
-                            .collect_view()}
+                            .map(IntoAny::into_any).collect_view()}
                     </select>
                 </label>
                 <label>
                     "Frequency "
-                    <select id="data-frequency" on:change=set(|f, v| f.frequency = v)>
+                    <select id="data-frequency" on:change=on_event(set(|f, v| f.frequency = v))>
                         <option value="high" selected>"MIB high frequency"</option>
                         <option value="low">"MIB low frequency"</option>
                         <option value="custom">"custom"</option>
@@ -266,14 +272,14 @@ fn DataRequestCard() -> impl IntoView {
                         id="data-custom-hz"
                         size="7"
                         prop:value=move || form.with(|f| f.custom_hz.clone())
-                        on:input=set(|f, v| f.custom_hz = v)
+                        on:input=on_event(set(|f, v| f.custom_hz = v))
                     />
                 </label>
                 <label hidden=move || form.with(|f| f.frequency != "custom")>
                     <input
                         type="checkbox"
                         id="data-overwrite"
-                        on:change=move |ev| form.update(|f| f.overwrite = event_target_checked(&ev))
+                        on:change=on_event(move |ev| form.update(|f| f.overwrite = event_target_checked(&ev)))
                     />
                     " overwrite MIB frequency"
                 </label>
@@ -284,14 +290,14 @@ fn DataRequestCard() -> impl IntoView {
                         size="3"
                         placeholder="MIB"
                         prop:value=move || form.with(|f| f.gain.clone())
-                        on:input=set(|f, v| f.gain = v)
+                        on:input=on_event(set(|f, v| f.gain = v))
                     />
                 </label>
                 <label>
                     <input
                         type="checkbox"
                         id="data-zc"
-                        on:change=move |ev| form.update(|f| f.zc = event_target_checked(&ev))
+                        on:change=on_event(move |ev| form.update(|f| f.zc = event_target_checked(&ev)))
                     />
                     " zero-crossing synchronisation"
                 </label>
@@ -301,7 +307,7 @@ fn DataRequestCard() -> impl IntoView {
                         id="data-header-length"
                         size="3"
                         prop:value=move || form.with(|f| f.header_length.clone())
-                        on:input=set(|f, v| f.header_length = v)
+                        on:input=on_event(set(|f, v| f.header_length = v))
                     />
                 </label>
             </div>
@@ -310,7 +316,7 @@ fn DataRequestCard() -> impl IntoView {
                     "Payload as "
                     <select
                         id="data-payload-kind"
-                        on:change=move |ev| form.update(|f| f.text = event_target_value(&ev) == "text")
+                        on:change=on_event(move |ev| form.update(|f| f.text = event_target_value(&ev) == "text"))
                     >
                         <option value="text" selected>"text"</option>
                         <option value="hex">"hex"</option>
@@ -321,12 +327,12 @@ fn DataRequestCard() -> impl IntoView {
                     class="payload"
                     size="60"
                     prop:value=move || form.with(|f| f.payload.clone())
-                    on:input=set(|f, v| f.payload = v)
+                    on:input=on_event(set(|f, v| f.payload = v))
                 />
-                <button id="data-send" on:click=send>"Send"</button>
+                {super::widgets::button("data-send", "Send", "", send)}
             </div>
-            <p id="data-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
-                {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
+            <p id="data-result" class:problem=move || problem.get()>
+                {move || result.get()}
             </p>
         </article>
     }
@@ -414,7 +420,7 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
                                     <td class="hex">{spaced(&payload(&e))}</td>
                                 </tr>
                             }
-                        }).collect_view()}
+                        }).map(IntoAny::into_any).collect_view()}
                 </tbody>
             </table>
         </article>

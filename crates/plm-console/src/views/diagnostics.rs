@@ -2,6 +2,7 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
+use super::widgets::{action_button, button, note, on_click, on_event, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -44,6 +45,7 @@ pub(crate) fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoVi
                 </tr>
             }
         })
+        .map(IntoAny::into_any)
         .collect_view()
 }
 
@@ -51,27 +53,35 @@ pub(crate) fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoVi
 fn PingCard() -> impl IntoView {
     let c = use_console();
     let payload = RwSignal::new(String::from("50 4c 4d 21"));
-    let result = RwSignal::new(None::<Result<String, String>>);
+    // What came of it, and whether that is a problem: two signals of types
+    // the page has anyway rather than one `Option<Result<String, String>>`
+    // (each signal type brings its own code, docs/console.md "Size").
+    let result = RwSignal::new(None::<String>);
+    let problem = RwSignal::new(false);
+    let show = move |r: Result<String, String>| {
+        problem.set(r.is_err());
+        result.set(Some(r.unwrap_or_else(|e| e)));
+    };
     let history = RwSignal::new(Vec::<u64>::new());
-    let ping = move |_| {
+    let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
             Ok(d) => {
-                result.set(Some(Err(format!(
+                show(Err(format!(
                     "nothing sent: a frame carries at most 255 bytes, not {}",
                     d.len()
-                ))));
+                )));
                 return;
             }
             Err(e) => {
-                result.set(Some(Err(format!("nothing sent: {e}"))));
+                show(Err(format!("nothing sent: {e}")));
                 return;
             }
         };
-        result.set(Some(Ok("sent, waiting for the answer…".into())));
+        show(Ok("sent, waiting for the answer…".into()));
         let sent = data.clone();
         c.request(Command::PingRequest { data }, move |o| {
-            result.set(Some(match o {
+            show(match o {
                 Outcome::Answer {
                     command: Command::PingConfirm { data },
                     rtt,
@@ -97,7 +107,7 @@ fn PingCard() -> impl IntoView {
                     Err(refusal(&command).unwrap_or_else(|| crate::stores::unexpected(&command)))
                 }
                 Outcome::Failed(why) => Err(why),
-            }))
+            })
         });
     };
     view! {
@@ -106,17 +116,11 @@ fn PingCard() -> impl IntoView {
             <p class="muted">"PingRequest (2Ch): the modem sends the payload back (UM0932 3.3.10)."</p>
             <label>
                 "Payload (hex) "
-                <input
-                    id="ping-payload"
-                    class="hex"
-                    size="30"
-                    prop:value=move || payload.get()
-                    on:input=move |ev| payload.set(event_target_value(&ev))
-                />
+                {text_input("ping-payload", "hex", "", Some(30), payload)}
             </label>
-            <button id="ping-send" on:click=ping>"Ping"</button>
-            <p id="ping-result" class:problem=move || matches!(result.get(), Some(Err(_)))>
-                {move || result.get().map(|r| r.unwrap_or_else(|e| e))}
+            {button("ping-send", "Ping", "", ping)}
+            <p id="ping-result" class:problem=move || problem.get()>
+                {move || result.get()}
             </p>
             <p class="muted" id="ping-history">
                 {move || {
@@ -243,19 +247,14 @@ fn FirmwareCard() -> impl IntoView {
         <article class="card" id="firmware">
             <h3>"Firmware version"</h3>
             <p class="muted">"MIB 0Ah (UM0932 4.2.10)."</p>
-            <button
-                id="firmware-read"
-                on:click=move |_| {
-                    message.set(Some("reading…".into()));
-                    c.read_mib(index::FIRMWARE_VERSION as u16, move |r| message.set(r.err()));
-                }
-            >
-                "Read"
-            </button>
+            {button("firmware-read", "Read", "", move || {
+                message.set(Some("reading…".into()));
+                c.read_mib(index::FIRMWARE_VERSION as u16, move |r| message.set(r.err()));
+            })}
             <p id="firmware-value" class="big">
                 {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_ascii_uppercase()))}
             </p>
-            <p class="problem">{move || message.get()}</p>
+            {note("", "problem", message)}
         </article>
     }
 }
@@ -264,7 +263,7 @@ fn FirmwareCard() -> impl IntoView {
 fn ResetCard() -> impl IntoView {
     let c = use_console();
     let message = RwSignal::new(None::<String>);
-    let reset = move |_| {
+    let reset = move || {
         message.set(Some("BIO_ResetRequest sent…".into()));
         c.request(Command::BioResetRequest, move |o| {
             message.set(Some(match o {
@@ -287,7 +286,7 @@ fn ResetCard() -> impl IntoView {
             <p class="muted">
                 "BIO_ResetRequest (3Ch) restarts the modem; MIB 00h-02h survive if written since power-on (UM0932 3.3.1)."
             </p>
-            <button id="reset-send" on:click=reset>"Reset modem"</button>
+            {button("reset-send", "Reset modem", "", reset)}
             <label
                 title="DTR drives the modem's RESETN on this port (kept per port): DTR is kept released"
             >
@@ -295,7 +294,7 @@ fn ResetCard() -> impl IntoView {
                     type="checkbox"
                     id="resetn-on-dtr"
                     prop:checked=move || c.conn.resetn_on_dtr.get()
-                    on:change=move |ev| c.set_resetn_on_dtr(event_target_checked(&ev))
+                    on:change=on_event(move |ev| c.set_resetn_on_dtr(event_target_checked(&ev)))
                 />
                 " RESETN wired to DTR"
             </label>
@@ -303,14 +302,14 @@ fn ResetCard() -> impl IntoView {
                 id="reset-resetn"
                 hidden=move || !c.conn.resetn_on_dtr.get()
                 title="DTR asserted 20 ms: a hardware reset"
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     c.pulse_resetn();
                     message.set(Some("RESETN pulsed: BIO_ResetIndication follows.".into()));
-                }
+                })
             >
                 "Reset modem (RESETN)"
             </button>
-            <p id="reset-result">{move || message.get()}</p>
+            {note("reset-result", "", message)}
             <h4>"Last BIO_ResetIndication"</h4>
             {move || match c.modem.last_reset.get() {
                 None => view! { <p class="muted">"None since connecting."</p> }.into_any(),
@@ -334,7 +333,7 @@ fn CountersCard() -> impl IntoView {
                 {[index::PHY_DATA, index::DL_DATA, index::SS_DATA]
                     .into_iter()
                     .map(|i| view! { <Counters index=i/> })
-                    .collect_view()}
+                    .map(IntoAny::into_any).collect_view()}
             </div>
         </article>
     }
@@ -349,7 +348,7 @@ fn Counters(index: u8) -> impl IntoView {
     let read = move || {
         c.read_mib(index as u16, move |r| message.set(r.err()));
     };
-    let erase = move |_| {
+    let erase = move || {
         c.erase_mib(index as u16, move |r| match r {
             Ok(_) => {
                 message.set(None);
@@ -361,13 +360,13 @@ fn Counters(index: u8) -> impl IntoView {
     view! {
         <div class="counters" id=format!("counters-{index:02x}")>
             <h4>{format!("{index:02X}h {}", o.name)}</h4>
-            <button data-action="read" on:click=move |_| read()>"Read"</button>
-            <button data-action="erase" on:click=erase>"Erase"</button>
+            {action_button("read", "Read", read)}
+            {action_button("erase", "Erase", erase)}
             {move || match value() {
                 None => view! { <p class="muted">"Not read yet."</p> }.into_any(),
                 Some(v) => view! { <table class="kv">{field_rows(o.fields, v)}</table> }.into_any(),
             }}
-            <p class="problem">{move || message.get()}</p>
+            {note("", "problem", message)}
         </div>
     }
 }

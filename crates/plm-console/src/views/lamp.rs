@@ -3,7 +3,7 @@
 //! ballast reset, and on a simulated street the faults a demo needs.
 
 use super::street::{computer_clock, dimming_value};
-use super::widgets::button;
+use super::widgets::{button, on_event, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
 use leptos::prelude::*;
@@ -21,13 +21,14 @@ fn pin_boxes(mask: RwSignal<u8>, id: &'static str) -> impl IntoView {
                     id=format!("{id}-{bit}")
                     title=format!("IO{bit}")
                     prop:checked=move || mask.get() & (1 << bit) != 0
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         let on = event_target_checked(&ev);
                         mask.update(|m| if on { *m |= 1 << bit } else { *m &= !(1 << bit) });
-                    }
+                    })
                 />
             }
         })
+        .map(IntoAny::into_any)
         .collect_view()
 }
 
@@ -159,14 +160,14 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 <figcaption>{format!("{name} {range}")}</figcaption>
                                 <svg viewBox="0 0 300 60" preserveAspectRatio="none"><polyline points=line/></svg>
                             </figure>
-                        }).collect_view()}
+                        }).map(IntoAny::into_any).collect_view()}
                         <div class="form-row">
                             {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
                             <label>
                                 "Dimming % "
-                                <input id="lamp-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                                {text_input("lamp-dim-level", "", "", Some(4), level)}
                             </label>
-                            <button id="lamp-dim" on:click=move |_| {
+                            {button("lamp-dim", "Dim", "", move || {
                                 match dimming_value(&level.get_untracked()) {
                                     Ok(v) => {
                                         let a = focus.get_untracked();
@@ -175,7 +176,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                     }
                                     Err(e) => note.set(Some(e)),
                                 }
-                            }>"Dim"</button>
+                            })}
                         </div>
                         <div class="form-row">
                             {button("", "Read clock", "", move || ask(Message::Service(Service::ClockGet), "clock"))}
@@ -193,30 +194,30 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         <div class="form-row pins">
                             <span class="muted">"level"</span>
                             {pin_boxes(outputs, "io-out")}
-                            <button id="lamp-io-out" on:click=move |_| {
+                            {button("lamp-io-out", "Set outputs", "", move || {
                                 match output_levels(io_config.get_untracked(), outputs.get_untracked()) {
                                     Ok(v) => ask(Message::Service(Service::OutputsSet(v)), "set GPIO outputs"),
                                     Err(e) => note.set(Some(e)),
                                 }
-                            }>"Set outputs"</button>
+                            })}
                         </div>
                         <h4>"Parameters"</h4>
                         <div class="form-row">
-                            <select on:change=move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2))>
+                            <select on:change=on_event(move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2)))>
                                 {plm_core::app::service::PROG_GROUPS.iter().enumerate().map(|(i, n)| view! {
                                     <option value=i.to_string() selected=i == 2>{*n}</option>
-                                }).collect_view()}
+                                }).map(IntoAny::into_any).collect_view()}
                             </select>
                             {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters"))}
-                            <button id="lamp-params-write" on:click=move |_| {
+                            {button("lamp-params-write", "Write", "", move || {
                                 let data = match plm_core::hex::parse(&params.get_untracked()) {
                                     Ok(d) => d,
                                     Err(e) => return note.set(Some(format!("nothing sent: {e}"))),
                                 };
                                 ask(Message::Service(Service::ParamSet { group: group.get_untracked(), data }), "write parameters")
-                            }>"Write"</button>
+                            })}
                         </div>
-                        <input id="lamp-params" class="payload hex" placeholder="32 bytes, hex" prop:value=move || params.get() on:input=move |ev| params.set(event_target_value(&ev))/>
+                        {text_input("lamp-params", "payload hex", "32 bytes, hex", None, params)}
                         {move || (street.port.get().contains("simulated")).then(|| view! {
                             <div class="form-row sim-actions">
                                 <span class="muted">"Simulator:"</span>
@@ -225,8 +226,8 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                 {button("lamp-sim-cut", "Cut supply", "", move || sim(LampAction::Cut))}
                                 {button("", "Restore supply", "", move || sim(LampAction::Join))}
                             </div>
-                        })}
-                        <p class="muted" id="lamp-note">{move || note.get().unwrap_or_default()}</p>
+                        }).map(IntoAny::into_any)}
+                        {super::widgets::note("lamp-note", "muted", note)}
                     }.into_any()
                 }
             }}

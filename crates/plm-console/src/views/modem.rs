@@ -7,6 +7,7 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
+use super::widgets::{action_button, button, on_event};
 use crate::mibform::{self, Problems};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -33,7 +34,7 @@ pub fn ModemView() -> impl IntoView {
         let dialect = c.profile.get().dialect();
         (plm_core::chip::for_dialect(dialect).mib(), dialect)
     });
-    let read_all = move |_| {
+    let read_all = move || {
         // What the modem has as configured now (an ST7570 in PHY mode
         // has no MAC objects).
         let readable: Vec<u16> = c.with_chip(|ch| {
@@ -69,14 +70,14 @@ pub fn ModemView() -> impl IntoView {
     };
     view! {
         <div class="toolbar">
-            <button id="mib-read-all" on:click=read_all>"Read all"</button>
+            {button("mib-read-all", "Read all", "", read_all)}
             <span class="muted" id="mib-progress">{move || progress.get()}</span>
             <Profiles/>
             <span class="muted">
-                {move || match objects.get().1 {
+                {move || String::from(match objects.get().1 {
                     plm_core::link::Dialect::St7580 => "ST7580 MIB (UM0932 4, Table 52).",
                     plm_core::link::Dialect::St7570 => "ST7570 MIB (ST7570 UM 6, Table 71).",
-                }}
+                })}
                 " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>
@@ -88,6 +89,7 @@ pub fn ModemView() -> impl IntoView {
                 let (list, dialect) = objects.get();
                 list.iter()
                     .map(|o| view! { <MibCard object=o dialect=dialect/> })
+                    .map(IntoAny::into_any)
                     .collect_view()
             }}
         </div>
@@ -102,7 +104,7 @@ fn Profiles() -> impl IntoView {
     let message = RwSignal::new(None::<String>);
     let running = RwSignal::new(false);
     let cancel = RwSignal::new(false);
-    let save = move |_| {
+    let save = move || {
         let values = c.modem.mib.get_untracked();
         let writable: Vec<u16> =
             c.with_chip(|ch| mibform::profile_objects(ch).map(|o| o.index).collect());
@@ -149,14 +151,14 @@ fn Profiles() -> impl IntoView {
         });
     };
     view! {
-        <button id="profile-save" on:click=save>"Save profile"</button>
+        {button("profile-save", "Save profile", "", save)}
         <label class="button">
             "Load profile…"
-            <input id="profile-load" type="file" accept=".json,application/json" on:change=load/>
+            <input id="profile-load" type="file" accept=".json,application/json" on:change=on_event(load)/>
         </label>
         {move || (running.get()).then(|| view! {
-            <button id="profile-cancel" on:click=move |_| cancel.set(true)>"Cancel"</button>
-        })}
+            {button("profile-cancel", "Cancel", "", move || cancel.set(true))}
+        }).map(IntoAny::into_any)}
         <span class="muted" id="profile-message">{move || message.get()}</span>
     }
 }
@@ -238,7 +240,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             })
         });
     };
-    let write = move |_| {
+    let write = move || {
         let data = match mibform::build(object, &base(), &inputs.get_untracked()) {
             Ok(d) => d,
             Err(p) => {
@@ -271,7 +273,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             Err(why) => status.set(format!("not written: {why}")),
         });
     };
-    let erase = move |_| {
+    let erase = move || {
         status.set("erasing…".into());
         c.erase_mib(idx, move |r| match r {
             Ok(_) => {
@@ -286,7 +288,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             Err(why) => status.set(format!("not erased: {why}")),
         });
     };
-    let load_default = move |_| {
+    let load_default = move || {
         inputs.set(inputs_of(object, object.default));
         problems.set(Problems::default());
         status.set("factory default loaded into the form: Write to send it".into());
@@ -319,22 +321,18 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                 <span class="muted">{object.section}</span>
             </header>
             <div class="actions">
-                {object.access.read.then(|| view! {
-                    <button data-action="read" on:click=move |_| read()>"Read"</button>
-                })}
+                {object.access.read.then(|| action_button("read", "Read", read))}
                 {writable
                     .then(|| {
                         view! {
-                            <button data-action="write" on:click=write>"Write"</button>
-                            <button data-action="default" on:click=load_default>
-                                "Factory default"
-                            </button>
+                            {action_button("write", "Write", write)}
+                            {action_button("default", "Factory default", load_default)}
                         }
                     })}
                 {object
                     .access
                     .erase
-                    .then(|| view! { <button data-action="erase" on:click=erase>"Erase"</button> })}
+                    .then(|| action_button("erase", "Erase", erase))}
                 {secret
                     .then(|| {
                         view! {
@@ -343,7 +341,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                                     type="checkbox"
                                     data-action="reveal"
                                     prop:checked=move || reveal.get()
-                                    on:change=move |ev| reveal.set(event_target_checked(&ev))
+                                    on:change=on_event(move |ev| reveal.set(event_target_checked(&ev)))
                                 />
                                 " Reveal key"
                             </label>
@@ -383,7 +381,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                                 />
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </tbody>
             </table>
             <p class="diff" data-role="diff">{diff}</p>
@@ -464,7 +462,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
     };
     match field.kind {
         Kind::Enum(names) => view! {
-            <select name=name on:change=move |ev| set(event_target_value(&ev))>
+            <select name=name on:change=on_event(move |ev| set(event_target_value(&ev)))>
                 {names
                     .iter()
                     .enumerate()
@@ -478,7 +476,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                             </option>
                         }
                     })
-                    .collect_view()}
+                    .map(IntoAny::into_any).collect_view()}
             </select>
         }
         .into_any(),
@@ -487,7 +485,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                 type="checkbox"
                 name=name
                 prop:checked=move || value() == "1"
-                on:change=move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into())
+                on:change=on_event(move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into()))
             />
         }
         .into_any(),
@@ -500,7 +498,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                 spellcheck="false"
                 size="34"
                 prop:value=value
-                on:input=move |ev| set(event_target_value(&ev))
+                on:input=on_event(move |ev| set(event_target_value(&ev)))
             />
         }
         .into_any(),
@@ -511,7 +509,7 @@ fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<b
                 name=name
                 size="10"
                 prop:value=value
-                on:input=move |ev| set(event_target_value(&ev))
+                on:input=on_event(move |ev| set(event_target_value(&ev)))
             />
         }
         .into_any(),

@@ -35,6 +35,7 @@ mod wasm {
     use crate::stores::{use_console, Console};
     use crate::transport::webserial::{self, OnLost, Settings, TReqPolarity, WebSerialTransport};
     use crate::transport::LinkState;
+    use crate::views::widgets::{on_click, on_event};
     use leptos::prelude::*;
     use plm_sim::BAUD_RATES;
     use std::rc::Rc;
@@ -49,6 +50,7 @@ mod wasm {
     const KEY_RTS_TWICE: &str = "plm-console.serial.rts-twice";
 
     use crate::storage::load;
+    use crate::views::widgets::button;
 
     fn save(key: &str, value: &str) {
         crate::storage::store(key, Some(value));
@@ -302,6 +304,7 @@ mod wasm {
                         </option>
                     }
                 })
+                .map(IntoAny::into_any)
                 .collect_view()
                 .into_any()
         };
@@ -314,6 +317,7 @@ mod wasm {
                     </option>
                 }
             })
+            .map(IntoAny::into_any)
             .collect_view();
         let polarities = TReqPolarity::ALL
             .into_iter()
@@ -324,6 +328,7 @@ mod wasm {
                     </option>
                 }
             })
+            .map(IntoAny::into_any)
             .collect_view();
         let controls = if supported {
             view! {
@@ -336,17 +341,11 @@ mod wasm {
                         <select
                             id="serial-port"
                             style="flex: 1"
-                            on:change=move |ev| selected.set(event_target_value(&ev).parse().ok())
+                            on:change=on_event(move |ev| selected.set(event_target_value(&ev).parse().ok()))
                         >
                             {ports}
                         </select>
-                        <button
-                            id="serial-choose"
-                            title="The browser asks which port this site may use, and remembers the answer."
-                            on:click=move |_| chooser.choose()
-                        >
-                            "Choose a port…"
-                        </button>
+                        {button("serial-choose", "Choose a port…", "The browser asks which port this site may use, and remembers the answer.", move || chooser.choose())}
                     </span>
                     <label
                         for="serial-baud"
@@ -356,11 +355,11 @@ mod wasm {
                     </label>
                     <select
                         id="serial-baud"
-                        on:change=move |ev| {
+                        on:change=on_event(move |ev| {
                             if let Ok(b) = event_target_value(&ev).parse() {
                                 baud.set(b);
                             }
-                        }
+                        })
                     >
                         {bauds}
                     </select>
@@ -372,11 +371,11 @@ mod wasm {
                     </label>
                     <select
                         id="serial-polarity"
-                        on:change=move |ev| {
+                        on:change=on_event(move |ev| {
                             if let Some(p) = TReqPolarity::from_key(&event_target_value(&ev)) {
                                 polarity.set(p);
                             }
-                        }
+                        })
                     >
                         {polarities}
                     </select>
@@ -388,7 +387,7 @@ mod wasm {
                             type="checkbox"
                             id="serial-rts-twice"
                             prop:checked=move || rts_twice.get()
-                            on:change=move |ev| rts_twice.set(event_target_checked(&ev))
+                            on:change=on_event(move |ev| rts_twice.set(event_target_checked(&ev)))
                         />
                         " Send each RTS change twice (Windows)"
                     </label>
@@ -407,7 +406,7 @@ mod wasm {
                     aria-expanded=move || open.get().to_string()
                     aria-controls="serial-panel"
                     title=if supported { "Connect to a real modem over WebSerial" } else { NO_WEB_SERIAL }
-                    on:click=move |_| open.update(|o| *o = !*o)
+                    on:click=on_click(move |_| open.update(|o| *o = !*o))
                 >
                     {summary}
                 </button>
@@ -426,25 +425,25 @@ mod wasm {
                             <button
                                 id="serial-connect"
                                 disabled=move || busy.get() || labels.with(Vec::is_empty)
-                                on:click=move |_| chooser.connect()
+                                on:click=on_click(move |_| chooser.connect())
                             >
-                                {move || if active() { "Reconnect" } else { "Connect over WebSerial" }}
+                                {move || String::from(if active() { "Reconnect" } else { "Connect over WebSerial" })}
                             </button>
-                        })}
+                        }).map(IntoAny::into_any)}
                         <button
                             id="serial-use-sim"
                             disabled=move || console.conn.kind.get() == "Simulated"
-                            on:click=move |_| chooser.use_simulator()
+                            on:click=on_click(move |_| chooser.use_simulator())
                         >
                             "Use the simulated modem"
                         </button>
-                        <button id="serial-close" on:click=move |_| open.set(false)>"Close"</button>
+                        {button("serial-close", "Close", "", move || open.set(false))}
                     </div>
                     {move || (message.with(Option::is_some)).then(|| view! {
                         <p class="message" id="serial-message" role="status">
                             {move || message.get().unwrap_or_default()}
                         </p>
-                    })}
+                    }).map(IntoAny::into_any)}
                 </div>
             </span>
         }

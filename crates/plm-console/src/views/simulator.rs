@@ -3,6 +3,7 @@
 //! UART byte faults, modem reset and unplug, and what happens on the line.
 
 use super::seconds;
+use super::widgets::{button, on_click, on_event};
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::st7580::fields::MODULATIONS;
@@ -56,7 +57,7 @@ pub fn SimulatorView() -> impl IntoView {
         <div class="cards">
             // Echoing peers belong to the bare-modem world; a street has
             // its own card.
-            {move || (!profile.get().is_street()).then(|| view! { <TopologyCard/> })}
+            {move || (!profile.get().is_street()).then(|| view! { <TopologyCard/> }).map(IntoAny::into_any)}
             <StreetCard/>
             <ModemFaultsCard/>
             <LineCard/>
@@ -81,30 +82,28 @@ fn StreetCard() -> impl IntoView {
                 "Lamps "
                 <select
                     id="sim-lamps"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(n) = event_target_value(&ev).parse() {
                             choice.set(n);
                         }
-                    }
+                    })
                 >
                     {[6usize, 12, 50, 100, 500]
                         .into_iter()
                         .map(|n| view! {
                             <option value=n.to_string() selected=move || choice.get() == n>{n.to_string()}</option>
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
-            <button id="sim-apply-street" on:click=move |_| {
+            {button("sim-apply-street", "Restart the street", "", move || {
                 c.sim.lamps.set(choice.get_untracked());
                 if c.profile.get_untracked().is_street() {
                     c.connect_simulated();
                 } else {
                     c.set_profile(crate::profile::Profile::StreetBoard);
                 }
-            }>
-                "Restart the street"
-            </button>
+            })}
             <FailureRate/>
         </article>
     }
@@ -141,7 +140,7 @@ fn FailureRate() -> impl IntoView {
                 "Random failures per lamp per lit hour "
                 {super::widgets::text_input("sim-failure-rate", "", "", Some(5), text)}
             </label>
-            {super::widgets::button("sim-apply-failures", "Apply", "", apply)}
+            {button("sim-apply-failures", "Apply", "", apply)}
         </div>
         {super::widgets::note("sim-failure-note", "muted", message)}
     }
@@ -161,11 +160,11 @@ fn TopologyCard() -> impl IntoView {
                 "Modems "
                 <select
                     id="sim-nodes"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(n) = event_target_value(&ev).parse() {
                             choice.set(n);
                         }
-                    }
+                    })
                 >
                     {[1usize, 2, 3, 5]
                         .into_iter()
@@ -181,15 +180,13 @@ fn TopologyCard() -> impl IntoView {
                                 </option>
                             }
                         })
-                        .collect_view()}
+                        .map(IntoAny::into_any).collect_view()}
                 </select>
             </label>
-            <button id="sim-apply-topology" on:click=move |_| {
+            {button("sim-apply-topology", "Restart the simulation", "", move || {
                 c.sim.nodes.set(choice.get_untracked());
                 c.set_profile(crate::profile::Profile::Modem);
-            }>
-                "Restart the simulation"
-            </button>
+            })}
             <p>
                 {move || format!("Running: {} modem(s); peers echoed {} frame(s).", c.sim.nodes.get(), c.sim.echoed.get())}
             </p>
@@ -205,30 +202,26 @@ fn ModemFaultsCard() -> impl IntoView {
         <article class="card" id="sim-modem">
             <h3>"Modem and cable"</h3>
             <div class="buttons">
-                <button id="sim-reset" on:click=move |_| inject(Fault::ModemReset)>
-                    "Pull RESETN (power-on reset)"
-                </button>
-                <button id="sim-watchdog" on:click=move |_| inject(Fault::Watchdog)>
-                    "Watchdog reset"
-                </button>
+                {button("sim-reset", "Pull RESETN (power-on reset)", "", move || inject(Fault::ModemReset))}
+                {button("sim-watchdog", "Watchdog reset", "", move || inject(Fault::Watchdog))}
                 <button
                     id="sim-plug"
-                    on:click=move |_| {
+                    on:click=on_click(move |_| {
                         inject(if c.sim.plugged.get_untracked() { Fault::Unplug } else { Fault::Plug })
-                    }
+                    })
                 >
-                    {move || if c.sim.plugged.get() { "Unplug the cable" } else { "Plug the cable in" }}
+                    {move || String::from(if c.sim.plugged.get() { "Unplug the cable" } else { "Plug the cable in" })}
                 </button>
             </div>
             <label>
                 "Temperature "
                 <select
                     id="sim-temperature"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         if let Ok(t) = event_target_value(&ev).parse::<u8>() {
                             inject(Fault::Temperature(Temperature::from_bits(t)));
                         }
-                    }
+                    })
                 >
                     <option value="0" selected>"below 70 °C"</option>
                     <option value="1">"70-100 °C"</option>
@@ -253,7 +246,7 @@ fn LineCard() -> impl IntoView {
     let loss = RwSignal::new("0".to_string());
     let corruption = RwSignal::new("0".to_string());
     let message = RwSignal::new(None::<String>);
-    let apply = move |_| {
+    let apply = move || {
         let noise_dbuv = match super::decimal(&noise.get_untracked()) {
             Some(v) if (0.0..=130.0).contains(&v) => v,
             _ => {
@@ -286,11 +279,11 @@ fn LineCard() -> impl IntoView {
             <p class="muted">
                 "TX level 100 dBµV at full gain, 30 dB between neighbours, 2 dB more per node in between."
             </p>
-            <TextField label="Noise floor (dBµV) " id="sim-noise" size=5 value=noise/>
-            <TextField label="Frame loss (%) " id="sim-loss" size=4 value=loss/>
-            <TextField label="Corruption (%) " id="sim-corruption" size=4 value=corruption/>
-            <button id="sim-apply-line" on:click=apply>"Apply"</button>
-            <p class="muted">{move || message.get()}</p>
+            {text_field("Noise floor (dBµV) ", "sim-noise", 5, noise)}
+            {text_field("Frame loss (%) ", "sim-loss", 4, loss)}
+            {text_field("Corruption (%) ", "sim-corruption", 4, corruption)}
+            {button("sim-apply-line", "Apply", "", apply)}
+            {super::widgets::note("", "muted", message)}
         </article>
     }
 }
@@ -307,7 +300,7 @@ fn UartCard() -> impl IntoView {
         c.with_simulator(|s| s.inject(f));
         message.set(Some("armed: it hits the next byte".into()));
     };
-    let apply = move |_| {
+    let apply = move || {
         let (Some(drop), Some(corrupt), Some(delay)) = (
             percent(&drop.get_untracked()),
             percent(&corrupt.get_untracked()),
@@ -337,37 +330,25 @@ fn UartCard() -> impl IntoView {
                 "Direction "
                 <select
                     id="sim-dir"
-                    on:change=move |ev| {
+                    on:change=on_event(move |ev| {
                         dir.set(if event_target_value(&ev) == "up" { Dir::ModemToHost } else { Dir::HostToModem })
-                    }
+                    })
                 >
                     <option value="down" selected>"host → modem"</option>
                     <option value="up">"modem → host"</option>
                 </select>
             </label>
             <div class="buttons">
-                <button id="sim-drop" on:click=move |_| inject(Fault::DropByte(dir.get_untracked()))>
-                    "Drop next byte"
-                </button>
-                <button
-                    id="sim-corrupt"
-                    on:click=move |_| inject(Fault::CorruptByte(dir.get_untracked(), 0x10))
-                >
-                    "Corrupt next byte"
-                </button>
-                <button
-                    id="sim-delay"
-                    on:click=move |_| inject(Fault::DelayByte(dir.get_untracked(), 15 * MS))
-                >
-                    "Delay next byte 15 ms"
-                </button>
+                {button("sim-drop", "Drop next byte", "", move || inject(Fault::DropByte(dir.get_untracked())))}
+                {button("sim-corrupt", "Corrupt next byte", "", move || inject(Fault::CorruptByte(dir.get_untracked(), 0x10)))}
+                {button("sim-delay", "Delay next byte 15 ms", "", move || inject(Fault::DelayByte(dir.get_untracked(), 15 * MS)))}
             </div>
             <p class="muted">"At random, for every byte this way:"</p>
-            <TextField label="drop % " id="sim-p-drop" size=4 value=drop/>
-            <TextField label="corrupt % " id="sim-p-corrupt" size=4 value=corrupt/>
-            <TextField label="delay % " id="sim-p-delay" size=4 value=delay/>
-            <button id="sim-apply-uart" on:click=apply>"Apply"</button>
-            <p class="muted">{move || message.get()}</p>
+            {text_field("drop % ", "sim-p-drop", 4, drop)}
+            {text_field("corrupt % ", "sim-p-corrupt", 4, corrupt)}
+            {text_field("delay % ", "sim-p-delay", 4, delay)}
+            {button("sim-apply-uart", "Apply", "", apply)}
+            {super::widgets::note("", "muted", message)}
         </article>
     }
 }
@@ -390,7 +371,7 @@ fn LineEventsCard() -> impl IntoView {
                 } else {
                     view! {
                         <ul class="events">
-                            {events.iter().rev().map(|e| view! { <li>{e.clone()}</li> }).collect_view()}
+                            {events.iter().rev().map(|e| view! { <li>{e.clone()}</li> }).map(IntoAny::into_any).collect_view()}
                         </ul>
                     }
                         .into_any()
@@ -400,23 +381,19 @@ fn LineEventsCard() -> impl IntoView {
     }
 }
 
-/// A labelled text input bound to `value` (checked when applied).
-#[component]
-fn TextField(
+/// A labelled text input bound to `value` (checked when applied); a
+/// plain function rather than a component: no props type to build.
+fn text_field(
     label: &'static str,
     id: &'static str,
     size: u32,
     value: RwSignal<String>,
-) -> impl IntoView {
+) -> AnyView {
     view! {
         <label>
             {label}
-            <input
-                id=id
-                size=size
-                prop:value=move || value.get()
-                on:input=move |ev| value.set(event_target_value(&ev))
-            />
+            {super::widgets::text_input(id, "", "", Some(size), value)}
         </label>
     }
+    .into_any()
 }

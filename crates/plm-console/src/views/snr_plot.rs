@@ -330,6 +330,7 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </text>
             }
         })
+        .map(IntoAny::into_any)
         .collect_view();
     let x_ticks = plot
         .x_ticks
@@ -342,6 +343,7 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </text>
             }
         })
+        .map(IntoAny::into_any)
         .collect_view();
     let legend = plot
         .legend
@@ -359,6 +361,7 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </text>
             }
         })
+        .map(IntoAny::into_any)
         .collect_view();
     let markers = plot
         .markers
@@ -375,6 +378,7 @@ pub fn draw(plot: Plot) -> impl IntoView {
                 </circle>
             }
         })
+        .map(IntoAny::into_any)
         .collect_view();
     let middle = (TOP + BOTTOM) / 2.0;
     view! {

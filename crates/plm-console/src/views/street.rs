@@ -4,7 +4,7 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
-use super::widgets::button;
+use super::widgets::{button, on_click, on_event, text_input};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -16,7 +16,9 @@ use plm_core::app::{Address, Message, Request};
 pub fn StreetView() -> impl IntoView {
     let street = use_console().street;
     let filter = RwSignal::new(String::new());
-    let sort = RwSignal::new(("address", true));
+    // The column sorted by, `-` before it when descending: a String signal
+    // as the page has many, not one of its own type (docs/console.md, "Size").
+    let sort = RwSignal::new(String::from("address"));
     let selected = street.selected;
     let focus = RwSignal::new(None::<Address>);
     let message = RwSignal::new(None::<String>);
@@ -28,8 +30,10 @@ pub fn StreetView() -> impl IntoView {
         let now = street.now.get();
         let mut rows: Vec<Row> =
             street.with_fleet(|f| f.values().map(|l| Row::of(l, now)).collect());
-        let (key, asc) = sort.get();
-        fleet::sort(&mut rows, key, asc);
+        sort.with(|s| match s.strip_prefix('-') {
+            Some(key) => fleet::sort(&mut rows, key, false),
+            None => fleet::sort(&mut rows, s, true),
+        });
         let f = filter.get();
         rows.retain(|r| r.matches(&f));
         rows
@@ -49,23 +53,16 @@ pub fn StreetView() -> impl IntoView {
         <div class="street">
             <div class="toolbar">
                 <span class="muted" id="street-port">{move || street.port.get()}</span>
-                <button id="street-discover" on:click=move |_| street.act(|s| s.discover())>
-                    "Discover"
-                </button>
+                {button("street-discover", "Discover", "", move || street.act(|s| s.discover()))}
                 <SweepControl/>
-                <input
-                    id="street-filter"
-                    placeholder="filter: address, state, \"trouble\""
-                    prop:value=move || filter.get()
-                    on:input=move |ev| filter.set(event_target_value(&ev))
-                />
+                {text_input("street-filter", "", "filter: address, state, \"trouble\"", None, filter)}
                 {button("street-export-csv", "Export CSV", "", move || export(false))}
                 {button("street-export-json", "Export JSON", "", move || export(true))}
             </div>
             <GroupActions selected=selected message=message/>
             {move || (message.with(|m| m.is_some())).then(|| view! {
-                <p class="message" id="street-message">{move || message.get().unwrap_or_default()}</p>
-            })}
+                {super::widgets::note("street-message", "message", message)}
+            }).map(IntoAny::into_any)}
             <Alerts focus=focus/>
             <div class="street-grid" class:with-lamp=move || focus.with(|f| f.is_some())>
                 <div class="table-wrap">
@@ -77,14 +74,14 @@ pub fn StreetView() -> impl IntoView {
                                         type="checkbox"
                                         id="fleet-select-all"
                                         title="select every lamp shown"
-                                        on:change=move |ev| {
+                                        on:change=on_event(move |ev| {
                                             let on = event_target_checked(&ev);
                                             selected.set(if on {
                                                 rows.get_untracked().iter().map(|r| r.address).collect()
                                             } else {
                                                 Vec::new()
                                             });
-                                        }
+                                        })
                                     />
                                 </th>
                                 {COLUMNS
@@ -95,25 +92,29 @@ pub fn StreetView() -> impl IntoView {
                                             <th
                                                 class="sortable"
                                                 data-key=key
-                                                on:click=move |_| sort.update(|s| *s = (key, if s.0 == key { !s.1 } else { true }))
+                                                on:click=on_click(move |_| sort.update(|s| *s = if s == key { format!("-{key}") } else { key.to_string() }))
                                             >
                                                 {*header}
-                                                {move || match sort.get() {
-                                                    (k, true) if k == key => " ▲",
-                                                    (k, false) if k == key => " ▼",
-                                                    _ => "",
-                                                }}
+                                                {move || String::from(sort.with(|s| {
+                                                    if s == key {
+                                                        " ▲"
+                                                    } else if s.strip_prefix('-') == Some(key) {
+                                                        " ▼"
+                                                    } else {
+                                                        ""
+                                                    }
+                                                }))}
                                             </th>
                                         }
                                     })
-                                    .collect_view()}
+                                    .map(IntoAny::into_any).collect_view()}
                             </tr>
                         </thead>
                         <tbody>
-                            <For
-                                each=move || rows.with(|r| r.iter().map(|r| r.address).collect::<Vec<_>>())
-                                key=|a| *a
-                                children=move |address| {
+                            {super::widgets::keyed_rows(
+                                move || rows.with(|r| r.iter().map(|r| row_key(r.address)).collect()),
+                                move |key| {
+                                    let address = key_address(key);
                                     let row = Memo::new(move |_| {
                                         street.version.track();
                                         let now = street.now.get();
@@ -124,19 +125,19 @@ pub fn StreetView() -> impl IntoView {
                                             data-address=address.to_string()
                                             class:trouble=move || row.with(|r| r.as_ref().is_some_and(|r| r.trouble))
                                             class:selected=move || focus.get() == Some(address)
-                                            on:click=move |_| focus.set(Some(address))
+                                            on:click=on_click(move |_| focus.set(Some(address)))
                                         >
-                                            <td on:click=|ev| ev.stop_propagation()>
+                                            <td on:click=on_click(|ev| ev.stop_propagation())>
                                                 <input
                                                     type="checkbox"
                                                     prop:checked=move || selected.with(|s| s.contains(&address))
-                                                    on:change=move |ev| {
+                                                    on:change=on_event(move |ev| {
                                                         let on = event_target_checked(&ev);
                                                         selected.update(|s| {
                                                             s.retain(|a| *a != address);
                                                             if on { s.push(address); }
                                                         });
-                                                    }
+                                                    })
                                                 />
                                             </td>
                                             {COLUMNS
@@ -154,26 +155,27 @@ pub fn StreetView() -> impl IntoView {
                                                     };
                                                     view! { <td class=cls data-key=key>{cell}</td> }
                                                 })
-                                                .collect_view()}
+                                                .map(IntoAny::into_any).collect_view()}
                                         </tr>
                                     }
-                                }
-                            />
+                                    .into_any()
+                                },
+                            )}
                         </tbody>
                     </table>
                     {move || (rows.with(|r| r.is_empty())).then(|| view! {
                         <p class="muted empty">
-                            {move || if street.discovering.get().is_some() {
+                            {move || String::from(if street.discovering.get().is_some() {
                                 "Looking for lamps on the line…"
                             } else {
                                 "No lamp matches. Discover finds the lamps on the line."
-                            }}
+                            })}
                         </p>
-                    })}
+                    }).map(IntoAny::into_any)}
                 </div>
                 {move || (focus.with(|f| f.is_some())).then(|| view! {
                     <super::lamp::LampPanel focus=focus/>
-                })}
+                }).map(IntoAny::into_any)}
             </div>
         </div>
     }
@@ -188,10 +190,10 @@ fn SweepControl() -> impl IntoView {
                 type="checkbox"
                 id="street-sweep"
                 prop:checked=move || street.sweep.get().on
-                on:change=move |ev| {
+                on:change=on_event(move |ev| {
                     let on = event_target_checked(&ev);
                     street.act(|s| s.set_sweep(on));
-                }
+                })
             />
             " Poll the street"
         </label>
@@ -257,7 +259,7 @@ fn GroupActions(
             (Ok(()), Some(l)) => format!("dimming {v} % sent to {} lamp(s)", l.len()),
         }));
     };
-    let set_clocks = move |_| {
+    let set_clocks = move || {
         let c = computer_clock();
         let r = street.act(|s| {
             s.request(
@@ -274,23 +276,21 @@ fn GroupActions(
         <div class="toolbar group">
             <label>
                 "Dimming % "
-                <input id="street-dim-level" size="4" prop:value=move || level.get() on:input=move |ev| level.set(event_target_value(&ev))/>
+                {text_input("street-dim-level", "", "", Some(4), level)}
             </label>
             <button
                 id="street-dim-selected"
                 prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=move |_| dim(Some(selected.get_untracked()))
+                on:click=on_click(move |_| dim(Some(selected.get_untracked())))
             >
                 {move || format!("Dim selected ({})", selected.with(|s| s.len()))}
             </button>
             {button("street-dim-all", "Dim all (broadcast)", "", move || dim(None))}
-            <button id="street-clock-all" on:click=set_clocks title="sets every lamp's clock to this computer's local time">
-                "Set all clocks from this computer"
-            </button>
+            {button("street-clock-all", "Set all clocks from this computer", "sets every lamp's clock to this computer's local time", set_clocks)}
             <button
                 id="street-clock-selected"
                 prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     let c = computer_clock();
                     let list = selected.get_untracked();
                     let r = street.act(|s| {
@@ -302,7 +302,7 @@ fn GroupActions(
                         Ok(()) => format!("clock {c} sent to {} lamp(s)", list.len()),
                         Err(e) => format!("nothing sent: {e}"),
                     }));
-                }
+                })
             >
                 "Set clocks of selected"
             </button>
@@ -325,15 +325,28 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         let address = r.alert.address;
                         view! {
                             <li>
-                                <a href="#street" on:click=move |_| focus.set(Some(address))>{address.to_string()}</a>
+                                <a href="#street" on:click=on_click(move |_| focus.set(Some(address)))>{address.to_string()}</a>
                                 {format!(" {} (at {})", r.alert.what, r.wall)}
                             </li>
                         }
-                    }).collect_view()}
+                    }).map(IntoAny::into_any).collect_view()}
                 </ul>
             </div>
-        })}
+        }).map(IntoAny::into_any)}
     }
+}
+
+/// A board address as the key of its row (6 bytes in a u64), and back.
+fn row_key(a: Address) -> u64 {
+    let mut k = [0; 8];
+    k[2..].copy_from_slice(&a.0);
+    u64::from_be_bytes(k)
+}
+
+fn key_address(key: u64) -> Address {
+    let mut a = [0; 6];
+    a.copy_from_slice(&key.to_be_bytes()[2..]);
+    Address(a)
 }
 
 #[cfg(test)]
@@ -346,5 +359,21 @@ mod tests {
         assert!(dimming_value("4o")
             .unwrap_err()
             .contains("not a dimming value"));
+    }
+
+    #[test]
+    fn a_row_key_gives_its_address_back() {
+        for a in [
+            Address([0; 6]),
+            Address([0x00, 0x80, 0xE1, 0x00, 0x00, 0x01]),
+            Address::BROADCAST,
+        ] {
+            assert_eq!(key_address(row_key(a)), a);
+        }
+        // Distinct addresses, distinct rows.
+        assert_ne!(
+            row_key(Address([0, 0, 0, 0, 0, 1])),
+            row_key(Address([1, 0, 0, 0, 0, 0]))
+        );
     }
 }

@@ -2,6 +2,7 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
+use super::widgets::{button, on_click, on_event};
 use super::{seconds, spaced};
 use crate::app::Tab;
 use crate::stores::use_console;
@@ -65,12 +66,12 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
             <PauseButton/>
             <button
                 id="traffic-clear"
-                on:click=move |_| {
+                on:click=on_click(move |_| {
                     c.traffic.log.update(|l| l.clear());
                     c.traffic.paused_at.set(None);
                     selected.set(None);
                     message.set(None);
-                }
+                })
             >
                 "Clear"
             </button>
@@ -96,7 +97,7 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
                         s
                     })
             }}
-            {move || c.traffic.paused_at.get().map(|_| " · PAUSED")}
+            {move || c.traffic.paused_at.get().map(|_| " · PAUSED".to_string())}
         </p>
         {move || message.get().map(|m| view! { <p class="message" id="traffic-message">{m}</p> })}
         <div class="traffic">
@@ -113,11 +114,16 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
                         </tr>
                     </thead>
                     <tbody>
-                        <For
-                            each=move || rows.get().1
-                            key=|e| e.seq
-                            children=move |e| view! { <Row entry=e selected=selected/> }
-                        />
+                        {super::widgets::keyed_rows(
+                            move || rows.with(|r| r.1.iter().map(|e| e.seq).collect()),
+                            move |seq| {
+                                // The row of an entry shown (the log holds them in order).
+                                let entry = rows.with_untracked(|r| {
+                                    r.1.binary_search_by_key(&seq, |e| e.seq).ok().map(|i| Arc::clone(&r.1[i]))
+                                });
+                                entry.map(|e| view! { <Row entry=e selected=selected/> }).into_any()
+                            },
+                        )}
                     </tbody>
                 </table>
             </div>
@@ -134,7 +140,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Way "
             <select
                 id="filter-from"
-                on:change=move |ev| filter.update(|f| f.from = event_target_value(&ev))
+                on:change=on_event(move |ev| filter.update(|f| f.from = event_target_value(&ev)))
             >
                 <option value="">"both"</option>
                 <option value="host">"host → modem"</option>
@@ -145,7 +151,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Kind "
             <select
                 id="filter-kind"
-                on:change=move |ev| filter.update(|f| f.kind = event_target_value(&ev))
+                on:change=on_event(move |ev| filter.update(|f| f.kind = event_target_value(&ev)))
             >
                 <option value="">"all"</option>
                 <option value="frame">"frames"</option>
@@ -159,10 +165,10 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Command "
             <select
                 id="filter-command"
-                on:change=move |ev| filter.update(|f| f.command = event_target_value(&ev))
+                on:change=on_event(move |ev| filter.update(|f| f.command = event_target_value(&ev)))
             >
                 <option value="">"all"</option>
-                {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).collect_view()}
+                {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).map(IntoAny::into_any).collect_view()}
             </select>
         </label>
     }
@@ -176,16 +182,16 @@ fn PauseButton() -> impl IntoView {
         <button
             id="traffic-pause"
             aria-pressed=move || paused.get().is_some().to_string()
-            on:click=move |_| {
+            on:click=on_click(move |_| {
                 if paused.get_untracked().is_some() {
                     paused.set(None);
                 } else {
                     let last = c.traffic.log.with_untracked(|l| l.next_seq().saturating_sub(1));
                     paused.set(Some(last));
                 }
-            }
+            })
         >
-            {move || if paused.get().is_some() { "Resume" } else { "Pause" }}
+            {move || String::from(if paused.get().is_some() { "Resume" } else { "Pause" })}
         </button>
     }
 }
@@ -193,7 +199,7 @@ fn PauseButton() -> impl IntoView {
 #[component]
 fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
     let c = use_console();
-    let export = move |_| {
+    let export = move || {
         let text = c.traffic.log.with_untracked(|l| l.export());
         let lines = text.lines().count();
         match files::download("plm-traffic.jsonl", "application/x-ndjson", &text) {
@@ -243,14 +249,14 @@ fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
         });
     };
     view! {
-        <button id="traffic-export" on:click=export>"Export JSONL"</button>
+        {button("traffic-export", "Export JSONL", "", export)}
         <label class="button">
             "Import JSONL…"
             <input
                 id="traffic-import"
                 type="file"
                 accept=".jsonl,.json,.txt,application/x-ndjson"
-                on:change=import
+                on:change=on_event(import)
             />
         </label>
     }
@@ -274,7 +280,7 @@ fn Row(entry: Arc<Entry>, selected: RwSignal<Option<u64>>) -> impl IntoView {
             class=format!("from-{from} kind-{}", entry.decoded.kind)
             class:bad=bad
             class:selected=move || selected.get() == Some(seq)
-            on:click=move |_| selected.set(Some(seq))
+            on:click=on_click(move |_| selected.set(Some(seq)))
         >
             <td class="num">{seq}</td>
             <td class="time">{entry.at.map(seconds).unwrap_or_else(|| "–".into())}</td>

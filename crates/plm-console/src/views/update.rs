@@ -7,7 +7,7 @@
 //! from what the browser kept; the results export as CSV.
 
 use super::files::{chosen_file, download, download_bytes, read_bytes};
-use super::widgets::{button, note, text_input};
+use super::widgets::{button, note, on_click, on_event, text_input};
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
 use leptos::prelude::*;
@@ -155,11 +155,11 @@ pub fn UpdateView() -> impl IntoView {
                     {button("update-resume", "Resume update", "", resume)}
                     {button("update-discard", "Discard", "the boards keep what they run; segments they hold are dropped at the next update", discard)}
                 </div>
-            })}
+            }).map(IntoAny::into_any)}
             <div class="toolbar">
                 <label>
                     "Image file "
-                    <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_file/>
+                    <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_event(on_file)/>
                 </label>
                 <span class="muted">"or make a simulated one: release "</span>
                 {text_input("update-make-release", "", "x.y", Some(5), make_release)}
@@ -181,14 +181,14 @@ pub fn UpdateView() -> impl IntoView {
             <div class="toolbar">
                 <label>
                     "Lamps "
-                    <select id="update-targets" on:change=move |ev| choice.set(event_target_value(&ev))>
+                    <select id="update-targets" on:change=on_event(move |ev| choice.set(event_target_value(&ev)))>
                         {move || target_options(street, choice)}
                     </select>
                 </label>
                 <button
                     id="update-start"
                     prop:disabled=move || running() == Some(true) || !chosen.with(|c| matches!(c, Some(Chosen { check: Ok(_), .. })))
-                    on:click=move |_| start()
+                    on:click=on_click(move |_| start())
                 >
                     "Start update"
                 </button>
@@ -244,6 +244,7 @@ fn target_options(street: StreetStore, choice: RwSignal<String>) -> impl IntoVie
             let selected = value == current;
             view! { <option value=value selected=selected>{label}</option> }
         })
+        .map(IntoAny::into_any)
         .collect_view()
 }
 
@@ -364,7 +365,7 @@ fn Progress() -> impl IntoView {
                                     <td><progress max="1000" value=pm.to_string()></progress></td>
                                     <td>{words.clone()}</td>
                                 </tr>
-                            }).collect_view()}
+                            }).map(IntoAny::into_any).collect_view()}
                         </tbody>
                     </table>
                 </div>

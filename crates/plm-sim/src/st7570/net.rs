@@ -375,16 +375,19 @@ impl Network {
 
     /// Delivers every slot part that ends at `now`.
     fn run_line(&mut self, now: Instant) {
+        // In order as they are taken (a handful at a time), not `sort()`:
+        // std's sort brings its own copy of its algorithms for each element
+        // type into the console's page (docs/console.md, "Size").
         let mut due: Vec<Due> = Vec::new();
         self.due.retain(|d| {
             if due_at(d) <= now {
-                due.push(*d);
+                let at = due.iter().position(|e| e > d).unwrap_or(due.len());
+                due.insert(at, *d);
                 false
             } else {
                 true
             }
         });
-        due.sort();
         for d in due {
             self.deliver(now, d);
         }
