@@ -4,8 +4,7 @@
 //! SPY timeline; with the simulated network, its Servers as the line sees
 //! them. What it shows is [`crate::network::NetworkLog`]'s.
 
-use super::diagnostics::field_rows;
-use super::widgets::{button, text_table};
+use super::widgets::{button, escape, on_click, on_event, rows_html, text_table};
 use super::{fixed, seconds};
 use crate::network::{address_text, sn_text, sync_text, Event};
 use crate::profile::Profile;
@@ -60,20 +59,31 @@ pub fn NetworkView() -> impl IntoView {
     }
 }
 
-/// A history as a list, newest first.
-fn history(id: &'static str, list: impl Fn() -> VecDeque<Event> + Send + 'static) -> AnyView {
-    view! {
-        <ul class="events" id=id>
-            {move || {
-                list()
-                    .into_iter()
-                    .rev()
-                    .map(|e| view! { <li><span class="muted">{seconds(e.at)}</span>" "{e.what}</li> })
-                    .collect_view()
-            }}
-        </ul>
-    }
-    .into_any()
+/// A history as a list, newest first, written as HTML (as
+/// [`text_table`]).
+fn history(
+    id: &'static str,
+    list: impl Fn() -> VecDeque<Event> + Send + Sync + 'static,
+) -> AnyView {
+    history_boxed(id, Box::new(list))
+}
+
+#[inline(never)]
+fn history_boxed(
+    id: &'static str,
+    list: Box<dyn Fn() -> VecDeque<Event> + Send + Sync>,
+) -> AnyView {
+    let html = move || {
+        list().iter().rev().fold(String::new(), |mut h, e| {
+            h.push_str(&format!(
+                "<li><span class=\"muted\">{}</span> {}</li>",
+                seconds(e.at),
+                escape(&e.what)
+            ));
+            h
+        })
+    };
+    view! { <ul class="events" id=id inner_html=html></ul> }.into_any()
 }
 
 #[component]
@@ -89,16 +99,17 @@ fn StatusCard() -> impl IntoView {
             <div class="buttons">
                 {button("net-status-ask", "Ask now", "The modem sends its status message when the host asks to send (T_REQ): this reads 00A1h", ask)}
             </div>
-            {move || match status() {
-                None => view! { <p class="muted">"No status message yet (one comes with every request)."</p> }.into_any(),
-                Some((at, s)) => {
-                    let row = s.row();
-                    view! {
-                        <p class="muted">{format!("{} (Table 11), {}", row.name(), seconds(at))}</p>
-                        <table class="kv">{field_rows(Row::of(s.emit()[0]).layout(), s.emit().to_vec())}</table>
-                    }.into_any()
-                }
-            }}
+            <p class="muted">{move || match status() {
+                None => "No status message yet (one comes with every request).".to_string(),
+                Some((at, s)) => format!("{} (Table 11), {}", s.row().name(), seconds(at)),
+            }}</p>
+            <table class="kv" inner_html=move || status().map_or(String::new(), |(_, s)| {
+                let rows: Vec<Vec<String>> = plm_core::mib::describe(Row::of(s.emit()[0]).layout(), &s.emit())
+                    .into_iter()
+                    .map(|(f, v)| vec![f.label.to_string(), v.to_string()])
+                    .collect();
+                rows_html(&["", ""], &rows)
+            })></table>
         </article>
     }
 }
@@ -314,15 +325,15 @@ fn SpyCard() -> impl IntoView {
     let net = c.modem.network;
     let slots = move || {
         net.with(|n| {
-            n.spy
-                .iter()
-                .map(|(at, kind, text)| {
-                    let (mark, class) = kind.mark();
-                    view! {
-                        <span class=format!("slot {class}") title=format!("{} {text}", seconds(*at))>{mark}</span>
-                    }
-                })
-                .collect_view()
+            n.spy.iter().fold(String::new(), |mut h, (at, kind, text)| {
+                let (mark, class) = kind.mark();
+                h.push_str(&format!(
+                    "<span class=\"slot {class}\" title=\"{} {}\">{mark}</span>",
+                    seconds(*at),
+                    escape(text)
+                ));
+                h
+            })
         })
     };
     view! {
@@ -330,7 +341,7 @@ fn SpyCard() -> impl IntoView {
         <article class="card wide" id="net-spy" hidden=move || net.with(|n| n.spy.is_empty() && n.status.is_none_or(|(_, s)| s.mode != 3))>
             <h3>"PHY Monitor: SPY timeline"</h3>
             <p class="muted">"One mark per SPY indication, oldest first (PHY Monitor, 5.3.17-5.3.22): S subframe, · no subframe, ? searching, F synchronization found, A alarm, - no alarm. Hover for S/N."</p>
-            <div class="timeline" id="net-spy-timeline">{slots}</div>
+            <div class="timeline" id="net-spy-timeline" inner_html=slots></div>
         </article>
     }
 }
@@ -341,42 +352,55 @@ fn SimulatedServers() -> impl IntoView {
     let c = use_console();
     let servers = c.sim.servers;
     let scale = RwSignal::new(1u64);
+    // The rows as HTML, their buttons handled by one listener on the
+    // table (as [`text_table`]): `data-node` says which Server.
     let rows = move || {
-        servers
-            .get()
-            .into_iter()
-            .map(|s| {
-                let node = s.node;
-                let cut = s.cut_off;
-                let last = s
+        servers.with(|list| {
+            list.iter().fold(String::new(), |mut h, s| {
+                let last: Vec<String> = s
                     .syncs
                     .iter()
                     .rev()
                     .take(3)
                     .map(|(at, y)| format!("{} {}", seconds(*at), sync_text(y)))
-                    .collect::<Vec<_>>()
-                    .join("; ");
-                view! {
-                    <tr id=format!("sim-server-{node}")>
-                        <td class="num">{node}</td>
-                        <td class="num">{address_text(s.address)}</td>
-                        <td>{if s.repeater { "Server, repeater" } else { "Server" }}</td>
-                        <td class="sync">{if s.synchronized { "synchronized" } else { "not synchronized" }}</td>
-                        <td class="num">{format!("{} / {}", s.indicated, s.answered)}</td>
-                        <td class="fields">{last}</td>
-                        <td>
-                            <button class="cut" on:click=move |_| c.with_sfsk(|t| t.cut_off(node, !cut))>
-                                {if cut { "Reconnect" } else { "Cut off" }}
-                            </button>
-                            " "
-                            <button class="alarm" title="Its host sends CMD_AlarmRequest: every node hears the alarm in the window of a slot" on:click=move |_| c.with_sfsk(|t| t.raise_alarm(node))>
-                                "Alarm"
-                            </button>
-                        </td>
-                    </tr>
-                }
+                    .collect();
+                h.push_str(&format!(
+                    "<tr id=\"sim-server-{n}\"><td class=\"num\">{n}</td><td class=\"num\">{}</td><td>{}</td><td class=\"sync\">{}</td><td class=\"num\">{} / {}</td><td class=\"fields\">{}</td><td><button class=\"cut\" data-node=\"{n}\">{}</button> <button class=\"alarm\" data-node=\"{n}\" title=\"Its host sends CMD_AlarmRequest: every node hears the alarm in the window of a slot\">Alarm</button></td></tr>",
+                    address_text(s.address),
+                    if s.repeater { "Server, repeater" } else { "Server" },
+                    if s.synchronized { "synchronized" } else { "not synchronized" },
+                    s.indicated,
+                    s.answered,
+                    escape(&last.join("; ")),
+                    if s.cut_off { "Reconnect" } else { "Cut off" },
+                    n = s.node,
+                ));
+                h
             })
-            .collect_view()
+        })
+    };
+    let act = move |ev: leptos::ev::MouseEvent| {
+        use wasm_bindgen::JsCast;
+        let Some(b) = ev
+            .target()
+            .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+            .and_then(|e| e.closest("button[data-node]").ok().flatten())
+        else {
+            return;
+        };
+        let node: usize = b
+            .get_attribute("data-node")
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(0);
+        let alarm = b.class_name() == "alarm";
+        let cut = servers.with_untracked(|l| l.iter().any(|s| s.node == node && s.cut_off));
+        c.with_sfsk(|t| {
+            if alarm {
+                t.raise_alarm(node)
+            } else {
+                t.cut_off(node, !cut)
+            }
+        });
     };
     view! {
         <article class="card wide" id="net-sim" hidden=move || servers.with(|s| s.is_empty())>
@@ -384,11 +408,11 @@ fn SimulatedServers() -> impl IntoView {
                 <p class="muted">"The Servers of the simulated network, as the line sees them (a real network shows only what your modem hears). They answer what is sent to them; \"Cut off\" drowns a node in noise, so that it loses synchronization once timeout-frame-not-OK (0003h) runs out."</p>
                 <div class="form-row">
                     <label title="From the next timeout started: one already running keeps its deadline">"MAC timeouts run "
-                        <select id="net-sim-scale" on:change=move |ev| {
+                        <select id="net-sim-scale" on:change=on_event(move |ev| {
                             let s = event_target_value(&ev).parse().unwrap_or(1);
                             scale.set(s);
                             c.with_sfsk(|t| t.set_timeout_scale(s));
-                        }>
+                        })>
                             {[1u64, 10, 60, 600].into_iter().map(|s| view! {
                                 <option value=s.to_string() selected=move || scale.get() == s>{format!("{s}× as fast")}</option>
                             }).collect_view()}
@@ -397,7 +421,7 @@ fn SimulatedServers() -> impl IntoView {
                 </div>
                 <table class="log" id="net-sim-table">
                     <thead><tr><th>"Node"</th><th>"Address"</th><th>"Role"</th><th>"Now"</th><th>"Frames to it / answered"</th><th>"Last synchronization changes"</th><th></th></tr></thead>
-                    <tbody>{rows}</tbody>
+                    <tbody inner_html=rows on:click=on_click(act)></tbody>
                 </table>
         </article>
     }

@@ -5,7 +5,7 @@
 
 use super::network::{code_name, send};
 use super::seconds;
-use super::widgets::{button, note, text_input, text_table};
+use super::widgets::{button, note, on_event, text_input, text_table};
 use crate::network::address_text;
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -132,12 +132,12 @@ fn SendCard() -> impl IntoView {
             <div class="form-row">
                 <label hidden=move || layer() == Layer::Phy>"DA "{text_input("sfsk-da", "", "001 or BROADCAST", Some(12), da)}</label>
                 <label hidden=move || layer() == Layer::Phy>"IC "
-                    <select id="sfsk-ic" on:change=move |ev| ic.set(event_target_value(&ev).parse().unwrap_or(0))>
+                    <select id="sfsk-ic" on:change=on_event(move |ev| ic.set(event_target_value(&ev).parse().unwrap_or(0)))>
                         {(0..=7u8).map(|i| view! { <option value=i.to_string() selected=move || ic.get() == i>{i}</option> }).collect_view()}
                     </select>
                 </label>
                 <label>"Payload "{text_input("sfsk-payload", "payload", "", None, text)}</label>
-                <label><input type="checkbox" id="sfsk-hex" prop:checked=move || hex.get() on:change=move |ev| hex.set(event_target_checked(&ev))/>" hex"</label>
+                <label><input type="checkbox" id="sfsk-hex" prop:checked=move || hex.get() on:change=on_event(move |ev| hex.set(event_target_checked(&ev)))/>" hex"</label>
                 {button("sfsk-send-btn", "Send", "", send_frame)}
             </div>
             {note("sfsk-problem", "problem", problem)}

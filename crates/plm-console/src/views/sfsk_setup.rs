@@ -3,7 +3,7 @@
 //! the checks of the declarative MIB ([`crate::mibform::build`]), and for
 //! a MAC Server its local address (0001h, Table 74).
 
-use super::widgets::{button, note, text_input};
+use super::widgets::{button, note, on_event, text_input};
 use crate::mibform::{build, input_text, Texts};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -28,7 +28,7 @@ fn choice(
     value: RwSignal<String>,
 ) -> AnyView {
     view! {
-        <select id=id on:change=move |ev| value.set(event_target_value(&ev))>
+        <select id=id on:change=on_event(move |ev| value.set(event_target_value(&ev)))>
             {options.iter().map(|&(v, label)| view! {
                 <option value=v selected=move || value.get() == v>{label}</option>
             }).collect_view()}

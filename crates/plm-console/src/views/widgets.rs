@@ -81,30 +81,53 @@ pub fn note(id: &'static str, class: &'static str, text: RwSignal<Option<String>
     .into_any()
 }
 
+/// `text` for HTML: `&`, `<`, `>` and `"` escaped (a payload may hold
+/// anything).
+pub fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The rows of a table of text cells as HTML: `classes` gives each
+/// column's cell class; a row's first cell is also its `data-key`.
+pub fn rows_html(classes: &[&str], rows: &[Vec<String>]) -> String {
+    let mut html = String::new();
+    for cells in rows {
+        let key = escape(cells.first().map_or("", |c| c));
+        html.push_str(&format!("<tr data-key=\"{key}\">"));
+        for (text, class) in cells.iter().zip(classes) {
+            html.push_str(&format!("<td class=\"{class}\">{}</td>", escape(text)));
+        }
+        html.push_str("</tr>");
+    }
+    html
+}
+
 /// A table of text cells, redrawn from `rows`: `columns` gives each
 /// column's heading and the class of its cells; a row's first cell is
-/// also its `data-key` (for finding it). One renderer for every such
-/// table: each table written as its own `view!` costs the console's wasm
-/// a copy of the element code.
+/// also its `data-key` (for finding it). Its body is written as HTML in
+/// one go: a table of text needs no element code of its own (each table
+/// written as a `view!` of rows costs the console's wasm a copy of it).
 #[inline(never)]
 pub fn text_table(
     id: &'static str,
     columns: &'static [(&'static str, &'static str)],
     rows: Box<dyn Fn() -> Vec<Vec<String>> + Send + Sync>,
 ) -> AnyView {
+    let classes: Vec<&str> = columns.iter().map(|(_, c)| *c).collect();
     view! {
         <table class="log" id=id>
             <thead><tr>{columns.iter().map(|(h, _)| view! { <th>{*h}</th> }).collect_view()}</tr></thead>
-            <tbody>
-                {move || rows().into_iter().map(|cells| {
-                    let key = cells.first().cloned().unwrap_or_default();
-                    view! {
-                        <tr data-key=key>
-                            {cells.into_iter().zip(columns).map(|(text, (_, class))| view! { <td class=*class>{text}</td> }).collect_view()}
-                        </tr>
-                    }
-                }).collect_view()}
-            </tbody>
+            <tbody inner_html=move || rows_html(&classes, &rows())></tbody>
         </table>
     }
     .into_any()
