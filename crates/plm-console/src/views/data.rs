@@ -4,7 +4,7 @@
 //! indications) as plm-core decoded them in the traffic log.
 
 use super::snr_plot::{self, Point};
-use super::widgets::on_event;
+use super::widgets::{on_event, text_table};
 use super::{millis, seconds, spaced};
 use crate::app::Tab;
 use crate::session::Outcome;
@@ -338,6 +338,18 @@ fn DataRequestCard() -> impl IntoView {
     }
 }
 
+/// The indications table's columns and their cells' classes.
+const INDICATION_COLUMNS: &[(&str, &str)] = &[
+    ("Time", "time"),
+    ("Indication", ""),
+    ("Modulation", ""),
+    ("Channel", ""),
+    ("PGA", ""),
+    ("SNR (dB)", ""),
+    ("ZC delay (13 µs)", ""),
+    ("Payload", "hex"),
+];
+
 #[component]
 fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
     let c = use_console();
@@ -391,38 +403,24 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
                     }
                 })
             }}
-            <table class="log" id="indications-table">
-                <thead>
-                    <tr>
-                        <th>"Time"</th>
-                        <th>"Indication"</th>
-                        <th>"Modulation"</th>
-                        <th>"Channel"</th>
-                        <th>"PGA"</th>
-                        <th>"SNR (dB)"</th>
-                        <th>"ZC delay (13 µs)"</th>
-                        <th>"Payload"</th>
-                    </tr>
-                </thead>
-                <tbody>
-                    // At most INDICATION_ROWS rows, rebuilt when one arrives: no
-                    // keyed list needed (and none of its code in the wasm).
-                    {move || rows.get().into_iter().map(|e| {
-                            view! {
-                                <tr>
-                                    <td class="time">{e.at.map(seconds).unwrap_or_default()}</td>
-                                    <td>{e.title()}</td>
-                                    <td>{field(&e, "frame_modulation")}</td>
-                                    <td>{field(&e, "rx_channel")}</td>
-                                    <td>{field(&e, "pga_value")}</td>
-                                    <td>{field(&e, "snr")}</td>
-                                    <td>{field(&e, "zc_delay")}</td>
-                                    <td class="hex">{spaced(&payload(&e))}</td>
-                                </tr>
-                            }
-                        }).map(IntoAny::into_any).collect_view()}
-                </tbody>
-            </table>
+            // At most INDICATION_ROWS rows, rewritten when one arrives.
+            {text_table("indications-table", INDICATION_COLUMNS, Box::new(move || {
+                rows.get()
+                    .iter()
+                    .map(|e| {
+                        vec![
+                            e.at.map(seconds).unwrap_or_default(),
+                            e.title(),
+                            field(e, "frame_modulation"),
+                            field(e, "rx_channel"),
+                            field(e, "pga_value"),
+                            field(e, "snr"),
+                            field(e, "zc_delay"),
+                            spaced(&payload(e)),
+                        ]
+                    })
+                    .collect()
+            }))}
         </article>
     }
 }

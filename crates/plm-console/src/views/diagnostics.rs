@@ -2,7 +2,7 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
-use super::widgets::{action_button, button, note, on_click, on_event, text_input};
+use super::widgets::{action_button, button, escape, note, on_click, on_event, text_input};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -28,25 +28,31 @@ pub fn DiagnosticsView() -> impl IntoView {
     }
 }
 
-/// Named values of `data` under `layout`, as table rows.
-pub(crate) fn field_rows(layout: &'static [Field], data: Vec<u8>) -> impl IntoView {
-    plm_core::mib::describe(layout, &data)
+/// Named values of `data` under `layout`, as the HTML rows of a table.
+pub(crate) fn fields_html(layout: &'static [Field], data: &[u8]) -> String {
+    plm_core::mib::describe(layout, data)
         .into_iter()
-        .map(|(f, v)| {
+        .fold(String::new(), |mut html, (f, v)| {
             let unit = if f.unit.is_empty() || v.as_i64().is_none() {
                 String::new()
             } else {
                 format!(" {}", f.unit)
             };
-            view! {
-                <tr data-field=f.name>
-                    <th>{f.label}</th>
-                    <td>{format!("{v}{unit}")}</td>
-                </tr>
-            }
+            html.push_str(&format!(
+                "<tr data-field=\"{}\"><th>{}</th><td>{}</td></tr>",
+                f.name,
+                escape(f.label),
+                escape(&format!("{v}{unit}"))
+            ));
+            html
         })
-        .map(IntoAny::into_any)
-        .collect_view()
+}
+
+/// Named values of `data` under `layout` as a table (`id` may be empty),
+/// written as HTML in one go (as `widgets::text_table`).
+pub(crate) fn field_table(id: &'static str, layout: &'static [Field], data: &[u8]) -> AnyView {
+    let html = fields_html(layout, data);
+    view! { <table class="kv" id=(!id.is_empty()).then_some(id) inner_html=html></table> }.into_any()
 }
 
 #[component]
@@ -158,7 +164,7 @@ fn StatusCard() -> impl IntoView {
                 None => view! { <p class="muted">"No status message yet: send any request."</p> }.into_any(),
                 Some(byte) => view! {
                     <p>{received}</p>
-                    <table class="kv">{field_rows(status::LAYOUT, vec![byte])}</table>
+                    {field_table("", status::LAYOUT, &[byte])}
                 }
                 .into_any(),
             }}
@@ -315,7 +321,7 @@ fn ResetCard() -> impl IntoView {
                 None => view! { <p class="muted">"None since connecting."</p> }.into_any(),
                 Some((at, byte)) => view! {
                     <p>{format!("ResetData {byte:02X}h at {}", seconds(at))}</p>
-                    <table class="kv" id="reset-cause">{field_rows(reset_data::LAYOUT, vec![byte])}</table>
+                    {field_table("reset-cause", reset_data::LAYOUT, &[byte])}
                 }
                 .into_any(),
             }}
@@ -364,7 +370,7 @@ fn Counters(index: u8) -> impl IntoView {
             {action_button("erase", "Erase", erase)}
             {move || match value() {
                 None => view! { <p class="muted">"Not read yet."</p> }.into_any(),
-                Some(v) => view! { <table class="kv">{field_rows(o.fields, v)}</table> }.into_any(),
+                Some(v) => field_table("", o.fields, &v),
             }}
             {note("", "problem", message)}
         </div>

@@ -4,7 +4,8 @@
 //! SPY timeline; with the simulated network, its Servers as the line sees
 //! them. What it shows is [`crate::network::NetworkLog`]'s.
 
-use super::widgets::{button, escape, on_click, on_event, rows_html, text_table};
+use super::diagnostics::fields_html;
+use super::widgets::{button, escape, on_click, on_event, text_table};
 use super::{fixed, seconds};
 use crate::network::{address_text, sn_text, sync_text, Event};
 use crate::profile::Profile;
@@ -104,11 +105,7 @@ fn StatusCard() -> impl IntoView {
                 Some((at, s)) => format!("{} (Table 11), {}", s.row().name(), seconds(at)),
             }}</p>
             <table class="kv" inner_html=move || status().map_or(String::new(), |(_, s)| {
-                let rows: Vec<Vec<String>> = plm_core::mib::describe(Row::of(s.emit()[0]).layout(), &s.emit())
-                    .into_iter()
-                    .map(|(f, v)| vec![f.label.to_string(), v.to_string()])
-                    .collect();
-                rows_html(&["", ""], &rows)
+                fields_html(Row::of(s.emit()[0]).layout(), &s.emit())
             })></table>
         </article>
     }

@@ -3,7 +3,7 @@
 //! UART byte faults, modem reset and unplug, and what happens on the line.
 
 use super::seconds;
-use super::widgets::{button, on_click, on_event};
+use super::widgets::{button, escape, on_click, on_event};
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::st7580::fields::MODULATIONS;
@@ -370,9 +370,10 @@ fn LineEventsCard() -> impl IntoView {
                         .into_any()
                 } else {
                     view! {
-                        <ul class="events">
-                            {events.iter().rev().map(|e| view! { <li>{e.clone()}</li> }).map(IntoAny::into_any).collect_view()}
-                        </ul>
+                        <ul class="events" inner_html=events.iter().rev().fold(String::new(), |mut h, e| {
+                            h.push_str(&format!("<li>{}</li>", escape(e)));
+                            h
+                        })></ul>
                     }
                         .into_any()
                 }

@@ -7,7 +7,7 @@
 //! from what the browser kept; the results export as CSV.
 
 use super::files::{chosen_file, download, download_bytes, read_bytes};
-use super::widgets::{button, note, on_click, on_event, text_input};
+use super::widgets::{button, escape, note, on_click, on_event, text_input};
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
 use leptos::prelude::*;
@@ -357,16 +357,17 @@ fn Progress() -> impl IntoView {
                 <div class="table-wrap">
                     <table class="log" id="update-boards">
                         <thead><tr><th>"Lamp"</th><th>"State"</th><th>"Segments held"</th><th>"Result"</th></tr></thead>
-                        <tbody>
-                            {s.lines.iter().map(|(a, st, pm, words)| view! {
-                                <tr class=if words.starts_with("not updated") { "trouble" } else { "" }>
-                                    <td>{a.to_string()}</td>
-                                    <td>{*st}</td>
-                                    <td><progress max="1000" value=pm.to_string()></progress></td>
-                                    <td>{words.clone()}</td>
-                                </tr>
-                            }).map(IntoAny::into_any).collect_view()}
-                        </tbody>
+                        // Written as HTML in one go (as widgets::text_table).
+                        <tbody inner_html=s.lines.iter().fold(String::new(), |mut h, (a, st, pm, words)| {
+                            h.push_str(&format!(
+                                "<tr class=\"{}\"><td>{}</td><td>{}</td><td><progress max=\"1000\" value=\"{pm}\"></progress></td><td>{}</td></tr>",
+                                if words.starts_with("not updated") { "trouble" } else { "" },
+                                escape(&a.to_string()),
+                                escape(st),
+                                escape(words),
+                            ));
+                            h
+                        })></tbody>
                     </table>
                 </div>
             </div>
