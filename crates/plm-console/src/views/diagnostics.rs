@@ -52,7 +52,8 @@ pub(crate) fn fields_html(layout: &'static [Field], data: &[u8]) -> String {
 /// written as HTML in one go (as `widgets::text_table`).
 pub(crate) fn field_table(id: &'static str, layout: &'static [Field], data: &[u8]) -> AnyView {
     let html = fields_html(layout, data);
-    view! { <table class="kv" id=(!id.is_empty()).then_some(id) inner_html=html></table> }.into_any()
+    view! { <table class="kv" id=(!id.is_empty()).then_some(id) inner_html=html></table> }
+        .into_any()
 }
 
 #[component]
