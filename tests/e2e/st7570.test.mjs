@@ -73,7 +73,7 @@ test('an out-of-range ST7570 value is refused in the form with the reason, and n
   await refusedFrequency(page, 'st7570-refused', ST7570_F);
 });
 
-test('a MAC Client asks a Server and sees its answer, the synchronization of that Server lost and found, and an alarm sent', async (t) => {
+test('a MAC Client asks a Server and sees its answer, the synchronization of that Server lost and found, and alarms both ways', async (t) => {
   const page = await open(t, '?profile=st7570');
   await macClient(page);
 
@@ -102,7 +102,11 @@ test('a MAC Client asks a Server and sees its answer, the synchronization of tha
   await tab(page, 'network');
   await server.locator('td.fields').filter({ hasText: /^\d+\.\d+ s CONFIRMED/ }).waitFor({ timeout: 10_000 });
 
+  // Alarms both ways: one from Server 001h received, one sent.
+  await server.locator('button.alarm').click();
+  await page.locator('#net-alarm-history', { hasText: 'alarm received' }).waitFor({ timeout: 10_000 });
   await page.click('#net-alarm');
   await page.locator('#net-alarm-history', { hasText: 'alarm sent: LP_OK' }).waitFor({ timeout: 10_000 });
+  await page.locator('#net-alarms').scrollIntoViewIfNeeded();
   await shot(page, 'st7570-network');
 });
