@@ -12,7 +12,7 @@ use plm_core::st7570::fields::{self as f, sn_dbuv, snr_db};
 use plm_core::st7570::mac::ns_count;
 use plm_core::st7570::{Address, Command, Credit, Layer, MacSync, SignalNoise, Status};
 use plm_core::time::Instant;
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::VecDeque;
 
 /// Entries kept in each history, newest last.
 pub const KEPT: usize = 100;
@@ -98,8 +98,10 @@ pub struct NetworkLog {
     pub status: Option<(Instant, Status)>,
     /// Synchronization found, confirmed, lost (with the cause).
     pub syncs: VecDeque<Event>,
-    /// Nodes heard, by MAC address.
-    pub heard: BTreeMap<u16, Heard>,
+    /// Nodes heard, in the order of their MAC addresses (a list kept in
+    /// order: a map type of its own would bring its own copy of the tree
+    /// code into the console's wasm).
+    pub heard: Vec<(u16, Heard)>,
     /// Alarms sent and received.
     pub alarms: VecDeque<Event>,
     /// Repeater calls and their results.
@@ -228,7 +230,7 @@ impl NetworkLog {
                 },
             ),
             Command::MacDataIndication(m) => {
-                let h = self.heard.entry(m.address.sa).or_default();
+                let h = self.node(m.address.sa);
                 h.frames += 1;
                 h.last = at;
                 h.credit = Some(m.credit);
@@ -293,6 +295,18 @@ impl NetworkLog {
         }
     }
 
+    /// The entry of the node at `address`, made when first heard.
+    fn node(&mut self, address: u16) -> &mut Heard {
+        let i = match self.heard.binary_search_by_key(&address, |(a, _)| *a) {
+            Ok(i) => i,
+            Err(i) => {
+                self.heard.insert(i, (address, Heard::default()));
+                i
+            }
+        };
+        &mut self.heard[i].1
+    }
+
     fn sync(&mut self, at: Instant, what: String) {
         keep(&mut self.syncs, KEPT, Event { at, what });
     }
@@ -315,7 +329,7 @@ impl NetworkLog {
         let head = p_sdu.get(2..8)?;
         ns_count([head[0], head[1]])?;
         let sa = Address::from_bytes([head[3], head[4], head[5]]).sa;
-        let h = self.heard.entry(sa).or_default();
+        let h = self.node(sa);
         h.frames += 1;
         h.last = at;
         h.credit = Some(Credit::from_byte(head[2]));
@@ -393,7 +407,11 @@ mod tests {
         log.on_indication(6, &frame(&data(1)));
         log.on_indication(7, &frame(&data(2)));
         assert_eq!(log.heard.len(), 2);
-        let h = &log.heard[&1];
+        // Kept in the order of the addresses.
+        log.on_indication(8, &frame(&data(0)));
+        let order: Vec<u16> = log.heard.iter().map(|(a, _)| *a).collect();
+        assert_eq!(order, [0, 1, 2]);
+        let h = &log.heard[1].1;
         assert_eq!((h.frames, h.last, h.delta_phase), (2, 6, Some(3)));
         assert_eq!(
             h.credit,
