@@ -407,11 +407,7 @@ mod tests {
         log.on_indication(6, &frame(&data(1)));
         log.on_indication(7, &frame(&data(2)));
         assert_eq!(log.heard.len(), 2);
-        // Kept in the order of the addresses.
-        log.on_indication(8, &frame(&data(0)));
-        let order: Vec<u16> = log.heard.iter().map(|(a, _)| *a).collect();
-        assert_eq!(order, [0, 1, 2]);
-        let h = &log.heard[1].1;
+        let h = &log.heard[0].1;
         assert_eq!((h.frames, h.last, h.delta_phase), (2, 6, Some(3)));
         assert_eq!(
             h.credit,
@@ -422,6 +418,10 @@ mod tests {
             })
         );
         assert_eq!(log.received.back().unwrap().address, Some((2, 0xC00)));
+        // Kept in the order of the addresses.
+        log.on_indication(8, &frame(&data(0)));
+        let order: Vec<u16> = log.heard.iter().map(|(a, _)| *a).collect();
+        assert_eq!(order, [0, 1, 2]);
     }
 
     #[test]
