@@ -12,7 +12,6 @@ use plm_core::st7570::fields::{self as f, sn_dbuv, snr_db};
 use plm_core::st7570::mac::ns_count;
 use plm_core::st7570::{Address, Command, Credit, Layer, MacSync, SignalNoise, Status};
 use plm_core::time::Instant;
-use std::collections::VecDeque;
 
 /// Entries kept in each history, newest last.
 pub const KEPT: usize = 100;
@@ -97,26 +96,29 @@ pub struct NetworkLog {
     /// The last status message, read per its row of Table 11.
     pub status: Option<(Instant, Status)>,
     /// Synchronization found, confirmed, lost (with the cause).
-    pub syncs: VecDeque<Event>,
+    pub syncs: Vec<Event>,
     /// Nodes heard, in the order of their MAC addresses (a list kept in
     /// order: a map type of its own would bring its own copy of the tree
     /// code into the console's wasm).
     pub heard: Vec<(u16, Heard)>,
     /// Alarms sent and received.
-    pub alarms: VecDeque<Event>,
+    pub alarms: Vec<Event>,
     /// Repeater calls and their results.
-    pub calls: VecDeque<Event>,
+    pub calls: Vec<Event>,
     /// Frames indicated, newest last.
-    pub received: VecDeque<Received>,
+    pub received: Vec<Received>,
     /// Monitor mode: one entry per SPY indication, newest last.
-    pub spy: VecDeque<(Instant, SpyKind, String)>,
+    pub spy: Vec<(Instant, SpyKind, String)>,
 }
 
-fn keep<T>(list: &mut VecDeque<T>, max: usize, item: T) {
+/// Adds `item` to a bounded history, the oldest out when full (plain
+/// lists: a `VecDeque` of each item type would bring its own code into
+/// the console's wasm, and these hold a hundred items).
+fn keep<T>(list: &mut Vec<T>, max: usize, item: T) {
     if list.len() == max {
-        list.pop_front();
+        list.remove(0);
     }
-    list.push_back(item);
+    list.push(item);
 }
 
 /// S/N in words: `S0 62.0 / N0 30.0, S1 61.5 / N1 30.0 dBµV`.
@@ -417,7 +419,7 @@ mod tests {
                 dc: 0
             })
         );
-        assert_eq!(log.received.back().unwrap().address, Some((2, 0xC00)));
+        assert_eq!(log.received.last().unwrap().address, Some((2, 0xC00)));
         // Kept in the order of the addresses.
         log.on_indication(8, &frame(&data(0)));
         let order: Vec<u16> = log.heard.iter().map(|(a, _)| *a).collect();
@@ -562,7 +564,7 @@ mod tests {
         s.request(ask(), count(&confirmed));
         run(&mut s, &mut log, 4_000);
         assert_eq!(confirmed.get(), 1, "LM_OK");
-        let answer = log.received.back().expect("Server 001h answered");
+        let answer = log.received.last().expect("Server 001h answered");
         assert_eq!(answer.address, Some((1, 0xC00)));
         assert!(answer.payload.starts_with(b"!001"), "{:?}", answer.payload);
         // Confirmed by that frame, then lost once 0003h (40 s / 60) passed
@@ -643,7 +645,7 @@ mod tests {
             log.on_indication(i, &frame(&Command::SpySearchSynchroIndication));
         }
         assert_eq!(log.spy.len(), SPY_SLOTS);
-        assert_eq!(log.spy.front().unwrap().0, 5);
-        assert_eq!(log.spy.back().unwrap().1, SpyKind::Search);
+        assert_eq!(log.spy.first().unwrap().0, 5);
+        assert_eq!(log.spy.last().unwrap().1, SpyKind::Search);
     }
 }

@@ -68,7 +68,7 @@ impl SfskTransport {
                     cut_off: n.extra_noise_dbuv.is_some(),
                     indicated: r.indicated,
                     answered: r.answered,
-                    syncs: r.syncs.iter().cloned().collect(),
+                    syncs: r.syncs.clone(),
                 })
             })
             .collect()

@@ -7,7 +7,7 @@
 use super::diagnostics::fields_html;
 use super::widgets::{button, escape, on_click, on_event, text_table};
 use super::{fixed, seconds};
-use crate::network::{address_text, sn_text, sync_text, Event};
+use crate::network::{address_text, sn_text, sync_text, Event, NetworkLog};
 use crate::profile::Profile;
 use crate::session::Outcome;
 use crate::stores::{use_console, Console};
@@ -15,7 +15,6 @@ use leptos::prelude::*;
 use plm_core::st7570::fields as f;
 use plm_core::st7570::status::Row;
 use plm_core::st7570::Command;
-use std::collections::VecDeque;
 
 /// Sends an ST7570 `command`; `done` gets the answer read in the access
 /// layer the modem is in, or why there is none.
@@ -60,28 +59,21 @@ pub fn NetworkView() -> impl IntoView {
     }
 }
 
-/// A history as a list, newest first, written as HTML (as
-/// [`text_table`]).
-fn history(
-    id: &'static str,
-    list: impl Fn() -> VecDeque<Event> + Send + Sync + 'static,
-) -> AnyView {
-    history_boxed(id, Box::new(list))
-}
-
+/// A history of the network log as a list, newest first, written as
+/// HTML (as [`text_table`]); `list` picks it.
 #[inline(never)]
-fn history_boxed(
-    id: &'static str,
-    list: Box<dyn Fn() -> VecDeque<Event> + Send + Sync>,
-) -> AnyView {
+fn history(id: &'static str, list: fn(&NetworkLog) -> &Vec<Event>) -> AnyView {
+    let net = use_console().modem.network;
     let html = move || {
-        list().iter().rev().fold(String::new(), |mut h, e| {
-            h.push_str(&format!(
-                "<li><span class=\"muted\">{}</span> {}</li>",
-                seconds(e.at),
-                escape(&e.what)
-            ));
-            h
+        net.with(|n| {
+            list(n).iter().rev().fold(String::new(), |mut h, e| {
+                h.push_str(&format!(
+                    "<li><span class=\"muted\">{}</span> {}</li>",
+                    seconds(e.at),
+                    escape(&e.what)
+                ));
+                h
+            })
         })
     };
     view! { <ul class="events" id=id inner_html=html></ul> }.into_any()
@@ -151,7 +143,7 @@ fn SyncCard() -> impl IntoView {
             </div>
             {super::widgets::note("", "muted", result)}
             <h4>"History (CMD_SynchroIndication, Table 18)"</h4>
-            {history("net-sync-history", move || net.with(|n| n.syncs.clone()))}
+            {history("net-sync-history", |n| &n.syncs)}
         </article>
     }
 }
@@ -231,7 +223,7 @@ fn AlarmCard() -> impl IntoView {
             <div class="buttons">
                 {button("net-alarm", "Send an alarm", "CMD_AlarmRequest (5.3.15): the 3-byte alarm in the next slot's window", alarm)}
             </div>
-            {history("net-alarm-history", move || net.with(|n| n.alarms.clone()))}
+            {history("net-alarm-history", |n| &n.alarms)}
         </article>
     }
 }
@@ -311,7 +303,7 @@ fn RepeaterCallCard() -> impl IntoView {
                 {button("net-rc-send", "Call", "", call)}
             </div>
             {super::widgets::note("", "problem", problem)}
-            {history("net-rc-history", move || net.with(|n| n.calls.clone()))}
+            {history("net-rc-history", |n| &n.calls)}
         </article>
     }
 }

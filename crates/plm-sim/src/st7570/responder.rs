@@ -35,7 +35,9 @@ pub struct Responder {
     /// The modem's last [`SYNC_HISTORY`] CMD_SynchroIndications (Table
     /// 18), when they came: what a demo shows of a Server's
     /// synchronization.
-    pub syncs: VecDeque<(Instant, MacSync)>,
+    /// (A list: it runs in the console's page too, where a `VecDeque` of
+    /// its own item type would bring its own code.)
+    pub syncs: Vec<(Instant, MacSync)>,
 }
 
 impl Responder {
@@ -60,7 +62,7 @@ impl Responder {
             waiting: None,
             indicated: 0,
             answered: 0,
-            syncs: VecDeque::new(),
+            syncs: Vec::new(),
         }
     }
 
@@ -95,9 +97,9 @@ impl Responder {
                         Ok(Command::DataConfirm { confirm_code: 0xFF }) => self.answered += 1,
                         Ok(Command::MacSynchroIndication(sync)) => {
                             if self.syncs.len() == SYNC_HISTORY {
-                                self.syncs.pop_front();
+                                self.syncs.remove(0);
                             }
-                            self.syncs.push_back((at, sync));
+                            self.syncs.push((at, sync));
                         }
                         _ => {}
                     }
