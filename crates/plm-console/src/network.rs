@@ -7,6 +7,7 @@
 //! views so that it can be tested natively; the Network and Data views
 //! read it, [`crate::stores::Console`] feeds it.
 
+use plm_core::field::Value;
 use plm_core::link::LocalFrame;
 use plm_core::st7570::fields::{self as f, sn_dbuv, snr_db};
 use plm_core::st7570::mac::ns_count;
@@ -138,12 +139,11 @@ pub fn address_text(a: u16) -> String {
     format!("{a:03X}h")
 }
 
-fn name(table: &[&'static str], i: u8) -> &'static str {
-    table
-        .get(i as usize)
-        .copied()
-        .filter(|s| !s.is_empty())
-        .unwrap_or("undefined")
+/// The manual's name of `code` in `table`, or the code marked undefined,
+/// worded as the decoder words an enumerated value ([`Value`]'s display).
+pub fn named(table: &[&'static str], code: u8) -> String {
+    let name = table.get(code as usize).copied().filter(|s| !s.is_empty());
+    Value::Enum { raw: code, name }.to_string()
 }
 
 /// A MAC CMD_SynchroIndication in words (Table 18).
@@ -157,13 +157,13 @@ pub fn sync_text(s: &MacSync) -> String {
         ),
         MacSync::Lost { cause, add1, add2 } => format!(
             "LOST, cause {cause}: {} (ADD1 {}, ADD2 {})",
-            name(f::LOST_CAUSES, cause),
+            named(f::LOST_CAUSES, cause),
             address_text(add1),
             address_text(add2)
         ),
         MacSync::Intelligent { cause, add, .. } => format!(
             "INTELLIGENT: {} (initiator {})",
-            name(f::INTELLIGENT_CAUSES, cause),
+            named(f::INTELLIGENT_CAUSES, cause),
             address_text(add)
         ),
         MacSync::Other { sync, .. } => format!("SYNC {sync} (undefined)"),
@@ -225,10 +225,10 @@ impl NetworkLog {
                 match locked {
                     Some(l) => format!(
                         "{}: initiator {}",
-                        name(f::IS_STATUSES, is_status),
+                        named(f::IS_STATUSES, is_status),
                         address_text(l.add)
                     ),
-                    None => name(f::IS_STATUSES, is_status).to_string(),
+                    None => named(f::IS_STATUSES, is_status),
                 },
             ),
             Command::MacDataIndication(m) => {
@@ -467,32 +467,46 @@ mod tests {
         }
     }
 
+    /// The console's simulated ST7570 network (node 0 and three Servers).
+    fn simulated_network() -> crate::session::Session {
+        crate::session::Session::new(
+            Some(Box::new(crate::transport::sfsk::SfskTransport::new(
+                4, 57_600, 7,
+            ))),
+            plm_core::link::Dialect::St7570,
+        )
+    }
+
+    /// The session's simulated network.
+    fn net(s: &mut crate::session::Session) -> &mut crate::transport::sfsk::SfskTransport {
+        s.transport_mut().and_then(|t| t.sfsk()).unwrap()
+    }
+
+    /// Writes 00A1h with operating `mode` and access `layer` (Table 137)
+    /// and reads it back, as the set-up card does: the status message of
+    /// the read is the new mode's.
+    fn set_up(s: &mut crate::session::Session, mode: u8, layer: u8) {
+        use plm_core::st7570::mib::{index, object, PlcConfiguration};
+        let mut plc = PlcConfiguration::decode(object(index::PLC_CONFIGURATION).unwrap().default);
+        (plc.operating_mode, plc.access_layer_mode) = (mode, layer);
+        s.request(
+            s.chip().mib_write(index::PLC_CONFIGURATION, &plc.encode()),
+            Box::new(|_| {}),
+        );
+        s.request(
+            s.chip().mib_read(index::PLC_CONFIGURATION),
+            Box::new(|_| {}),
+        );
+    }
+
     /// The console's simulated network with its modem a PHY Monitor: one
     /// SPY indication per slot (searching, no Client on the line) makes
     /// the timeline.
     #[test]
     fn a_monitor_s_spy_indications_make_the_timeline() {
-        use crate::session::Session;
-        use crate::transport::sfsk::SfskTransport;
-        use plm_core::link::Dialect;
-        use plm_core::st7570::mib::{index, object, PlcConfiguration};
-        let mut s = Session::new(
-            Some(Box::new(SfskTransport::new(4, 57_600, 7))),
-            Dialect::St7570,
-        );
+        let mut s = simulated_network();
         let (mut log, mut page) = (NetworkLog::default(), 1_000_000.0);
-        let mut plc = PlcConfiguration::decode(object(index::PLC_CONFIGURATION).unwrap().default);
-        (plc.operating_mode, plc.access_layer_mode) = (3, 1);
-        s.request(
-            s.chip().mib_write(index::PLC_CONFIGURATION, &plc.encode()),
-            Box::new(|_| {}),
-        );
-        // Read back, as the set-up card does: its status message is the
-        // Monitor's.
-        s.request(
-            s.chip().mib_read(index::PLC_CONFIGURATION),
-            Box::new(|_| {}),
-        );
+        set_up(&mut s, 3, 1);
         drive(&mut s, &mut log, &mut page, 3_000);
         assert_eq!(log.status.map(|(_, st)| st.mode), Some(3));
         let kinds: Vec<SpyKind> = log.spy.iter().map(|(_, k, _)| *k).collect();
@@ -508,35 +522,16 @@ mod tests {
     #[test]
     fn a_simulated_server_answers_loses_synchronization_and_finds_it_again() {
         use crate::session::{Outcome, Session};
-        use crate::transport::sfsk::SfskTransport;
-        use plm_core::link::Dialect;
-        use plm_core::st7570::mib::{index, object, PlcConfiguration};
         use plm_core::st7570::Address;
 
-        let mut s = Session::new(
-            Some(Box::new(SfskTransport::new(4, 57_600, 7))),
-            Dialect::St7570,
-        );
+        let mut s = simulated_network();
         let mut log = NetworkLog::default();
         let mut page = 1_000_000.0;
         let mut run = |s: &mut Session, log: &mut NetworkLog, ms: u32| drive(s, log, &mut page, ms);
-        let sfsk = |s: &mut Session| {
-            s.transport_mut()
-                .and_then(|t| t.sfsk())
-                .map(|t| t.servers())
-                .unwrap()
-        };
+        let sfsk = |s: &mut Session| net(s).servers();
         // Scaled first: a timeout already running keeps its deadline.
-        s.transport_mut()
-            .and_then(|t| t.sfsk())
-            .unwrap()
-            .set_timeout_scale(60);
-        let mut plc = PlcConfiguration::decode(object(index::PLC_CONFIGURATION).unwrap().default);
-        (plc.operating_mode, plc.access_layer_mode) = (1, 2);
-        s.request(
-            s.chip().mib_write(index::PLC_CONFIGURATION, &plc.encode()),
-            Box::new(|_| {}),
-        );
+        net(&mut s).set_timeout_scale(60);
+        set_up(&mut s, 1, 2);
         run(&mut s, &mut log, 1_000);
         let ask = || {
             Command::MacDataRequest(MacData {
@@ -586,10 +581,7 @@ mod tests {
 
         // Cut off, it hears nothing: the Client's frame goes (LM_OK) and
         // no answer comes.
-        s.transport_mut()
-            .and_then(|t| t.sfsk())
-            .unwrap()
-            .cut_off(1, true);
+        net(&mut s).cut_off(1, true);
         s.request(ask(), count(&confirmed));
         run(&mut s, &mut log, 4_000);
         assert_eq!((confirmed.get(), log.received.len()), (2, 1));
@@ -598,10 +590,7 @@ mod tests {
         assert_eq!(one.syncs.len(), causes.len(), "{:?}", one.syncs);
 
         // Reconnected: found and confirmed again, and it answers.
-        s.transport_mut()
-            .and_then(|t| t.sfsk())
-            .unwrap()
-            .cut_off(1, false);
+        net(&mut s).cut_off(1, false);
         s.request(ask(), count(&confirmed));
         run(&mut s, &mut log, 4_000);
         assert_eq!((confirmed.get(), log.received.len()), (3, 2));
@@ -617,9 +606,6 @@ mod tests {
 
         // An alarm from Server 001h (synchronized: 0003h at 40 s again)
         // reaches the Client's host.
-        fn net(s: &mut Session) -> &mut SfskTransport {
-            s.transport_mut().and_then(|t| t.sfsk()).unwrap()
-        }
         net(&mut s).set_timeout_scale(1);
         s.request(ask(), count(&confirmed));
         run(&mut s, &mut log, 2_000);

@@ -7,7 +7,7 @@
 use super::diagnostics::fields_html;
 use super::widgets::{button, escape, on_click, on_event, text_table};
 use super::{fixed, seconds};
-use crate::network::{address_text, sn_text, sync_text, Event, NetworkLog};
+use crate::network::{address_text, named, sn_text, sync_text, Event, NetworkLog};
 use crate::profile::Profile;
 use crate::session::Outcome;
 use crate::stores::{use_console, Console};
@@ -28,14 +28,6 @@ pub fn send(c: Console, command: Command, done: impl FnOnce(Result<Command, Stri
             },
         )
     });
-}
-
-/// The name of `code` in a sparse table of confirm codes.
-pub fn code_name(table: &[&'static str; 256], code: u8) -> String {
-    match table[code as usize] {
-        "" => format!("{code:02X}h (undefined)"),
-        name => name.to_string(),
-    }
 }
 
 /// The view.
@@ -204,7 +196,7 @@ fn AlarmCard() -> impl IntoView {
                 Ok(Command::AlarmConfirm { confirm_code }) => {
                     format!(
                         "alarm sent: {}",
-                        code_name(&f::ALARM_CONFIRM_CODES, confirm_code)
+                        named(&f::ALARM_CONFIRM_CODES[..], confirm_code)
                     )
                 }
                 Ok(other) => format!(
@@ -265,10 +257,7 @@ fn RepeaterCallCard() -> impl IntoView {
                         repeater_state,
                         heard,
                     }) => {
-                        let state = f::REPEATER_STATES
-                            .get(repeater_state as usize)
-                            .copied()
-                            .unwrap_or("?");
+                        let state = named(f::REPEATER_STATES, repeater_state);
                         let heard = heard.map_or(String::new(), |h| {
                             format!(
                                 ", heard S {} N {} dBµV in sub-slot {}",
@@ -279,7 +268,7 @@ fn RepeaterCallCard() -> impl IntoView {
                         });
                         format!(
                             "TX_POS {tx_pos}: {}, repeater {state}{heard}",
-                            code_name(&f::RC_RESULTS, result)
+                            named(&f::RC_RESULTS[..], result)
                         )
                     }
                     Ok(other) => format!(

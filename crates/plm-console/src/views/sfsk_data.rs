@@ -3,10 +3,10 @@
 //! (Table 40), and the frames indicated (Tables 37-38), read from
 //! [`crate::network::NetworkLog`].
 
-use super::network::{code_name, send};
+use super::network::send;
 use super::seconds;
 use super::widgets::{button, note, on_event, text_input, text_table};
-use crate::network::address_text;
+use crate::network::{address_text, named};
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::st7570::fields::{self as f, P_SDU_LEN};
@@ -112,7 +112,7 @@ fn SendCard() -> impl IntoView {
         send(c, command, move |r| {
             result.set(Some(match r {
                 Ok(Command::DataConfirm { confirm_code }) => {
-                    format!("CMD_DataConfirm: {}", code_name(table, confirm_code))
+                    format!("CMD_DataConfirm: {}", named(table, confirm_code))
                 }
                 Ok(other) => format!(
                     "answered {}",
