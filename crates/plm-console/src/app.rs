@@ -122,7 +122,7 @@ pub fn App() -> impl IntoView {
     crate::bench_hook::install(console);
     crate::wake::install(move || console.tick());
     crate::wake::soon();
-    let tab = RwSignal::new(Tab::from_hash(&current_hash()));
+    let tab = crate::views::widgets::signal(Tab::from_hash(&current_hash()));
     let on_hash = window_event_listener(leptos::ev::hashchange, move |_| {
         tab.set(Tab::from_hash(&current_hash()));
     });

@@ -158,7 +158,7 @@ fn build(f: &Form, dl_crc_len: usize) -> Result<Command, String> {
 #[component]
 fn DataRequestCard() -> impl IntoView {
     let c = use_console();
-    let form = RwSignal::new(Form {
+    let form = crate::views::widgets::signal(Form {
         layer: "dl".into(),
         modulation: "0".into(),
         frequency: "high".into(),
@@ -173,8 +173,8 @@ fn DataRequestCard() -> impl IntoView {
     // What came of it, and whether that is a problem: two signals of types
     // the page has anyway rather than one `Option<Result<String, String>>`
     // (each signal type brings its own code, docs/console.md "Size").
-    let result = RwSignal::new(None::<String>);
-    let problem = RwSignal::new(false);
+    let result = crate::views::widgets::signal(None::<String>);
+    let problem = crate::views::widgets::signal(false);
     let show = move |r: Result<String, String>| {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));

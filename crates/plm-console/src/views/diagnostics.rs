@@ -59,17 +59,17 @@ pub(crate) fn field_table(id: &'static str, layout: &'static [Field], data: &[u8
 #[component]
 fn PingCard() -> impl IntoView {
     let c = use_console();
-    let payload = RwSignal::new(String::from("50 4c 4d 21"));
+    let payload = crate::views::widgets::signal(String::from("50 4c 4d 21"));
     // What came of it, and whether that is a problem: two signals of types
     // the page has anyway rather than one `Option<Result<String, String>>`
     // (each signal type brings its own code, docs/console.md "Size").
-    let result = RwSignal::new(None::<String>);
-    let problem = RwSignal::new(false);
+    let result = crate::views::widgets::signal(None::<String>);
+    let problem = crate::views::widgets::signal(false);
     let show = move |r: Result<String, String>| {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));
     };
-    let history = RwSignal::new(Vec::<u64>::new());
+    let history = crate::views::widgets::signal(Vec::<u64>::new());
     let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
@@ -244,7 +244,7 @@ fn AckLatencyCard() -> impl IntoView {
 #[component]
 fn FirmwareCard() -> impl IntoView {
     let c = use_console();
-    let message = RwSignal::new(None::<String>);
+    let message = crate::views::widgets::signal(None::<String>);
     let value = move || {
         c.modem
             .mib
@@ -269,7 +269,7 @@ fn FirmwareCard() -> impl IntoView {
 #[component]
 fn ResetCard() -> impl IntoView {
     let c = use_console();
-    let message = RwSignal::new(None::<String>);
+    let message = crate::views::widgets::signal(None::<String>);
     let reset = move || {
         message.set(Some("BIO_ResetRequest sent…".into()));
         c.request(Command::BioResetRequest, move |o| {
@@ -350,7 +350,7 @@ fn CountersCard() -> impl IntoView {
 fn Counters(index: u8) -> impl IntoView {
     let c = use_console();
     let o = object(index).expect("06h-08h are in Table 52");
-    let message = RwSignal::new(None::<String>);
+    let message = crate::views::widgets::signal(None::<String>);
     let value = move || c.modem.mib.with(|m| m.get(&(index as u16)).cloned());
     let read = move || {
         c.read_mib(index as u16, move |r| message.set(r.err()));

@@ -71,18 +71,18 @@ fn sparkline(points: &[(u64, f64)]) -> (String, String) {
 #[component]
 pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     let street = use_console().street;
-    let note = RwSignal::new(None::<String>);
-    let level = RwSignal::new(String::from("50"));
+    let note = crate::views::widgets::signal(None::<String>);
+    let level = crate::views::widgets::signal(String::from("50"));
     let lamp = Memo::new(move |_| {
         street.version.track();
         focus
             .get()
             .and_then(|a| street.with_fleet(|f| f.get(&a).cloned()))
     });
-    let io_config = RwSignal::new(0u8);
-    let outputs = RwSignal::new(0u8);
-    let group = RwSignal::new(2u8);
-    let params = RwSignal::new(String::new());
+    let io_config = crate::views::widgets::signal(0u8);
+    let outputs = crate::views::widgets::signal(0u8);
+    let group = crate::views::widgets::signal(2u8);
+    let params = crate::views::widgets::signal(String::new());
     let ask = move |m: Message, what: &'static str| {
         let Some(a) = focus.get_untracked() else {
             return;

@@ -28,7 +28,7 @@ fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
 #[component]
 pub fn ModemView() -> impl IntoView {
     let c = use_console();
-    let progress = RwSignal::new(None::<String>);
+    let progress = crate::views::widgets::signal(None::<String>);
     // The chip's objects, redrawn when the chip changes.
     let objects = Memo::new(move |_| {
         let dialect = c.profile.get().dialect();
@@ -45,8 +45,8 @@ pub fn ModemView() -> impl IntoView {
                 .collect()
         });
         let total = readable.len();
-        let done = RwSignal::new(0usize);
-        let failed = RwSignal::new(0usize);
+        let done = crate::views::widgets::signal(0usize);
+        let failed = crate::views::widgets::signal(0usize);
         progress.set(Some(format!("Reading 0 of {total}…")));
         for i in readable {
             c.read_mib(i, move |r| {
@@ -101,9 +101,9 @@ pub fn ModemView() -> impl IntoView {
 #[component]
 fn Profiles() -> impl IntoView {
     let c = use_console();
-    let message = RwSignal::new(None::<String>);
-    let running = RwSignal::new(false);
-    let cancel = RwSignal::new(false);
+    let message = crate::views::widgets::signal(None::<String>);
+    let running = crate::views::widgets::signal(false);
+    let cancel = crate::views::widgets::signal(false);
     let save = move || {
         let values = c.modem.mib.get_untracked();
         let writable: Vec<u16> =
@@ -209,9 +209,9 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
     let idx = object.index;
     let secret = dialect == plm_core::link::Dialect::St7580 && idx == index::SS_KEY as u16;
     let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
-    let inputs = RwSignal::new(inputs_of(object, object.default));
+    let inputs = crate::views::widgets::signal(inputs_of(object, object.default));
     const NOT_READ: &str = "not read yet: the form shows the factory default";
-    let status = RwSignal::new(String::from(NOT_READ));
+    let status = crate::views::widgets::signal(String::from(NOT_READ));
     Effect::new(move |_| {
         if let Some(v) = read_value.get() {
             inputs.set(inputs_of(object, &v));
@@ -222,8 +222,8 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             }
         }
     });
-    let problems = RwSignal::new(Problems::default());
-    let reveal = RwSignal::new(false);
+    let problems = crate::views::widgets::signal(Problems::default());
+    let reveal = crate::views::widgets::signal(false);
     let masked = Signal::derive(move || secret && !reveal.get());
     let base = move || {
         read_value

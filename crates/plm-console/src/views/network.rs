@@ -117,7 +117,7 @@ fn SyncCard() -> impl IntoView {
             ),
         })
     };
-    let result = RwSignal::new(None::<String>);
+    let result = crate::views::widgets::signal(None::<String>);
     let reject = move || {
         send(c, Command::DesynchroRequest { reset: 1 }, move |r| {
             result.set(Some(match r {
@@ -224,9 +224,9 @@ fn AlarmCard() -> impl IntoView {
 fn RepeaterCallCard() -> impl IntoView {
     let c = use_console();
     let net = c.modem.network;
-    let tx_pos = RwSignal::new("0".to_string());
-    let threshold = RwSignal::new("40".to_string());
-    let problem = RwSignal::new(None::<String>);
+    let tx_pos = crate::views::widgets::signal("0".to_string());
+    let threshold = crate::views::widgets::signal("40".to_string());
+    let problem = crate::views::widgets::signal(None::<String>);
     let call = move || {
         let pos = tx_pos
             .get_untracked()
@@ -329,7 +329,7 @@ fn SpyCard() -> impl IntoView {
 fn SimulatedServers() -> impl IntoView {
     let c = use_console();
     let servers = c.sim.servers;
-    let scale = RwSignal::new(1u64);
+    let scale = crate::views::widgets::signal(1u64);
     // The rows as HTML, their buttons handled by one listener on the
     // table (as [`text_table`]): `data-node` says which Server.
     let rows = move || {

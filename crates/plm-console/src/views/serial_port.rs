@@ -245,23 +245,23 @@ mod wasm {
         let chooser = Chooser {
             console,
             ports: StoredValue::new_local(Vec::new()),
-            labels: RwSignal::new(Vec::new()),
-            selected: RwSignal::new(None),
-            baud: RwSignal::new(
+            labels: crate::views::widgets::signal(Vec::new()),
+            selected: crate::views::widgets::signal(None),
+            baud: crate::views::widgets::signal(
                 load(KEY_BAUD)
                     .and_then(|b| b.parse().ok())
                     .filter(|b| BAUD_RATES.contains(b))
                     .unwrap_or_else(|| console.conn.baud.get_untracked()),
             ),
-            polarity: RwSignal::new(
+            polarity: crate::views::widgets::signal(
                 load(KEY_POLARITY)
                     .and_then(|p| TReqPolarity::from_key(&p))
                     .unwrap_or_default(),
             ),
-            rts_twice: RwSignal::new(load(KEY_RTS_TWICE).is_some()),
-            busy: RwSignal::new(false),
-            message: RwSignal::new(None),
-            open: RwSignal::new(false),
+            rts_twice: crate::views::widgets::signal(load(KEY_RTS_TWICE).is_some()),
+            busy: crate::views::widgets::signal(false),
+            message: crate::views::widgets::signal(None),
+            open: crate::views::widgets::signal(false),
         };
         if supported {
             chooser.refresh(None);

@@ -56,12 +56,12 @@ fn payload(text: &str, hex: bool) -> Result<Vec<u8>, String> {
 #[component]
 fn SendCard() -> impl IntoView {
     let c = use_console();
-    let da = RwSignal::new("001".to_string());
-    let ic = RwSignal::new(0u8);
-    let text = RwSignal::new("?".to_string());
-    let hex = RwSignal::new(false);
-    let problem = RwSignal::new(None::<String>);
-    let result = RwSignal::new(None::<String>);
+    let da = crate::views::widgets::signal("001".to_string());
+    let ic = crate::views::widgets::signal(0u8);
+    let text = crate::views::widgets::signal("?".to_string());
+    let hex = crate::views::widgets::signal(false);
+    let problem = crate::views::widgets::signal(None::<String>);
+    let result = crate::views::widgets::signal(None::<String>);
     let layer = move || c.modem.network.with(|n| n.layer());
     let send_frame = move || {
         let layer = c.modem.network.with_untracked(|n| n.layer());

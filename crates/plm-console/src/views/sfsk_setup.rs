@@ -50,17 +50,17 @@ pub fn SetupCard() -> impl IntoView {
     };
     let text = |f: &'static plm_core::field::Field| {
         let b = base();
-        RwSignal::new(input_text(f, &b))
+        crate::views::widgets::signal(input_text(f, &b))
     };
-    let role = RwSignal::new("0".to_string());
+    let role = crate::views::widgets::signal("0".to_string());
     let mains = text(&plc::MAINS_FREQUENCY);
     let bit_rate = text(&plc::BIT_RATE);
     let f0 = text(&plc::F0);
     let f1 = text(&plc::F1);
     let gain = text(&plc::TARGET_OUTPUT_GAIN);
-    let address = RwSignal::new("001".to_string());
-    let problem = RwSignal::new(None::<String>);
-    let result = RwSignal::new(None::<String>);
+    let address = crate::views::widgets::signal("001".to_string());
+    let problem = crate::views::widgets::signal(None::<String>);
+    let result = crate::views::widgets::signal(None::<String>);
     let server_mac = move || {
         role.get()
             .parse::<usize>()

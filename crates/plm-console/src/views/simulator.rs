@@ -71,7 +71,7 @@ pub fn SimulatorView() -> impl IntoView {
 #[component]
 fn StreetCard() -> impl IntoView {
     let c = use_console();
-    let choice = RwSignal::new(c.sim.lamps.get_untracked());
+    let choice = crate::views::widgets::signal(c.sim.lamps.get_untracked());
     view! {
         <article class="card" id="sim-street">
             <h3>"Street"</h3>
@@ -114,8 +114,8 @@ fn StreetCard() -> impl IntoView {
 #[component]
 fn FailureRate() -> impl IntoView {
     let c = use_console();
-    let text = RwSignal::new(super::fixed(c.sim.failure_rate.get_untracked(), 2));
-    let message = RwSignal::new(None::<String>);
+    let text = crate::views::widgets::signal(super::fixed(c.sim.failure_rate.get_untracked(), 2));
+    let message = crate::views::widgets::signal(None::<String>);
     let apply = move || match super::decimal(&text.get_untracked()) {
         Some(rate) if (0.0..=60.0).contains(&rate) => {
             c.sim.failure_rate.set(rate);
@@ -149,7 +149,7 @@ fn FailureRate() -> impl IntoView {
 #[component]
 fn TopologyCard() -> impl IntoView {
     let c = use_console();
-    let choice = RwSignal::new(c.sim.nodes.get_untracked());
+    let choice = crate::views::widgets::signal(c.sim.nodes.get_untracked());
     view! {
         <article class="card" id="sim-topology">
             <h3>"Topology"</h3>
@@ -242,10 +242,10 @@ fn percent(text: &str) -> Option<f64> {
 fn LineCard() -> impl IntoView {
     let c = use_console();
     let defaults = LineConfig::default();
-    let noise = RwSignal::new(super::fixed(defaults.noise_dbuv, 0));
-    let loss = RwSignal::new("0".to_string());
-    let corruption = RwSignal::new("0".to_string());
-    let message = RwSignal::new(None::<String>);
+    let noise = crate::views::widgets::signal(super::fixed(defaults.noise_dbuv, 0));
+    let loss = crate::views::widgets::signal("0".to_string());
+    let corruption = crate::views::widgets::signal("0".to_string());
+    let message = crate::views::widgets::signal(None::<String>);
     let apply = move || {
         let noise_dbuv = match super::decimal(&noise.get_untracked()) {
             Some(v) if (0.0..=130.0).contains(&v) => v,
@@ -291,11 +291,11 @@ fn LineCard() -> impl IntoView {
 #[component]
 fn UartCard() -> impl IntoView {
     let c = use_console();
-    let dir = RwSignal::new(Dir::HostToModem);
-    let drop = RwSignal::new("0".to_string());
-    let corrupt = RwSignal::new("0".to_string());
-    let delay = RwSignal::new("0".to_string());
-    let message = RwSignal::new(None::<String>);
+    let dir = crate::views::widgets::signal(Dir::HostToModem);
+    let drop = crate::views::widgets::signal("0".to_string());
+    let corrupt = crate::views::widgets::signal("0".to_string());
+    let delay = crate::views::widgets::signal("0".to_string());
+    let message = crate::views::widgets::signal(None::<String>);
     let inject = move |f: Fault| {
         c.with_simulator(|s| s.inject(f));
         message.set(Some("armed: it hits the next byte".into()));

@@ -15,13 +15,13 @@ use plm_core::app::{Address, Message, Request};
 #[component]
 pub fn StreetView() -> impl IntoView {
     let street = use_console().street;
-    let filter = RwSignal::new(String::new());
+    let filter = crate::views::widgets::signal(String::new());
     // The column sorted by, `-` before it when descending: a String signal
     // as the page has many, not one of its own type (docs/console.md, "Size").
-    let sort = RwSignal::new(String::from("address"));
+    let sort = crate::views::widgets::signal(String::from("address"));
     let selected = street.selected;
-    let focus = RwSignal::new(None::<Address>);
-    let message = RwSignal::new(None::<String>);
+    let focus = crate::views::widgets::signal(None::<Address>);
+    let message = crate::views::widgets::signal(None::<String>);
     // The rows shown, sorted and filtered; the table keys its lines by
     // address and each cell follows its own row, so a reading changes one
     // cell and a sort moves lines, without rebuilding the table.
@@ -242,7 +242,7 @@ fn GroupActions(
     message: RwSignal<Option<String>>,
 ) -> impl IntoView {
     let street = use_console().street;
-    let level = RwSignal::new(String::from("50"));
+    let level = crate::views::widgets::signal(String::from("50"));
     let parse = move || dimming_value(&level.get_untracked());
     let dim = move |targets: Option<Vec<Address>>| {
         let v = match parse() {

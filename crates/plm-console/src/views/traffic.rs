@@ -18,9 +18,9 @@ pub const MAX_ROWS: usize = 500;
 #[component]
 pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
     let c = use_console();
-    let filter = RwSignal::new(Filter::default());
-    let selected = RwSignal::new(None::<u64>);
-    let message = RwSignal::new(None::<String>);
+    let filter = crate::views::widgets::signal(Filter::default());
+    let selected = crate::views::widgets::signal(None::<u64>);
+    let message = crate::views::widgets::signal(None::<String>);
     // Hidden, the table keeps its rows and does not even look at the log:
     // redrawing it would only hold up the host's next ACK (issue 13), and
     // its tab brings it up to date.

@@ -70,11 +70,11 @@ fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
 #[component]
 pub fn UpdateView() -> impl IntoView {
     let street = use_console().street;
-    let chosen = RwSignal::new(None::<Chosen>);
-    let choice = RwSignal::new(String::from("all"));
-    let message = RwSignal::new(None::<String>);
-    let make_release = RwSignal::new(String::from("1.5"));
-    let make_size = RwSignal::new(String::from("24576"));
+    let chosen = crate::views::widgets::signal(None::<Chosen>);
+    let choice = crate::views::widgets::signal(String::from("all"));
+    let message = crate::views::widgets::signal(None::<String>);
+    let make_release = crate::views::widgets::signal(String::from("1.5"));
+    let make_size = crate::views::widgets::signal(String::from("24576"));
     let running = move || {
         street.campaign.track();
         street.read(|s| s.campaign().map(|c| !c.update.is_done()))
@@ -124,7 +124,7 @@ pub fn UpdateView() -> impl IntoView {
     };
     // A campaign kept in storage and not running here: after a reload, or
     // a new connection (the cable pulled and plugged in again).
-    let discarded = RwSignal::new(0u32);
+    let discarded = crate::views::widgets::signal(0u32);
     let cut_short = move || {
         street.campaign.track();
         street.port.track();

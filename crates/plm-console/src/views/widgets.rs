@@ -166,3 +166,11 @@ pub fn on_click(
 ) -> Box<dyn FnMut(web_sys::MouseEvent)> {
     Box::new(f)
 }
+
+/// A new signal holding `value`: `RwSignal::new` not inlined, so each
+/// signal of the page costs a call rather than its own copy of the
+/// arena's insertion code (one instance per value type).
+#[inline(never)]
+pub fn signal<T: Send + Sync + 'static>(value: T) -> RwSignal<T> {
+    RwSignal::new(value)
+}
