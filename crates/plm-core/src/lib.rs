@@ -34,6 +34,15 @@ extern crate alloc;
 #[cfg(test)]
 extern crate std;
 
+/// How the `crc` crate computes the checksums of this crate: with its
+/// 256-entry table natively, bit by bit in the browser, where the tables
+/// (five algorithms, 3.3 KB that gzip cannot shrink) count against the
+/// console's size budget and every checksummed frame is short.
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) type CrcImpl = crc::Table<1>;
+#[cfg(target_arch = "wasm32")]
+pub(crate) type CrcImpl = crc::NoTable;
+
 pub mod app;
 pub mod chip;
 pub mod decode;

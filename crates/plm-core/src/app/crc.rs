@@ -6,9 +6,10 @@
 //! check value BB3Dh). The seed's printed table has 14 wrong entries; the
 //! polynomial wins (docs/protocol-notes.md, "STEVAL-IHP007V1").
 
+use crate::CrcImpl;
 use crc::{Crc, CRC_16_ARC};
 
-const ARC: Crc<u16> = Crc::<u16>::new(&CRC_16_ARC);
+const ARC: Crc<u16, CrcImpl> = Crc::<u16, CrcImpl>::new(&CRC_16_ARC);
 
 /// CRC-16 of `bytes` as `CalcCRC16` computes it.
 pub fn crc16(bytes: &[u8]) -> u16 {

@@ -22,6 +22,7 @@
 pub mod image;
 
 use super::service::Release;
+use crate::CrcImpl;
 use crc::{Crc, CRC_32_ISO_HDLC};
 
 /// Largest image: an image slot (4.2: "the maximum size of the firmware
@@ -40,7 +41,7 @@ pub const RFU_STATUS_GET: u8 = 0x11;
 /// User-defined service command: forget a campaign.
 pub const RFU_ABORT: u8 = 0x12;
 
-const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
+const CRC32: Crc<u32, CrcImpl> = Crc::<u32, CrcImpl>::new(&CRC_32_ISO_HDLC);
 
 /// The CRC-32 of an image, as the header announces it and the swap checks.
 pub fn image_crc(image: &[u8]) -> u32 {

@@ -21,6 +21,7 @@ use super::types::{Address, Credit};
 use crate::field::Field;
 use alloc::vec::Vec;
 use core::fmt;
+use crate::CrcImpl;
 use crc::{Algorithm, Crc};
 
 /// Bytes of one MAC subframe, the P_sdu of a PHY frame (3.2, 4.4).
@@ -56,7 +57,7 @@ pub const FCS_ALGORITHM: Algorithm<u32> = Algorithm {
     check: 0xB0_C390,
     residue: 0,
 };
-const FCS: Crc<u32> = Crc::<u32>::new(&FCS_ALGORITHM);
+const FCS: Crc<u32, CrcImpl> = Crc::<u32, CrcImpl>::new(&FCS_ALGORITHM);
 
 /// The FCS of `bytes` (in a long frame: CREDIT up to the last pad byte).
 pub fn fcs(bytes: &[u8]) -> u32 {

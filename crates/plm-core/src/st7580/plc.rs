@@ -13,15 +13,16 @@ use aes::Aes128;
 use alloc::vec::Vec;
 use cmac::{Cmac, Mac};
 use core::fmt;
+use crate::CrcImpl;
 use crc::{Crc, CRC_16_IBM_3740, CRC_32_ISO_HDLC, CRC_8_SMBUS};
 use ctr::cipher::{KeyIvInit, StreamCipher};
 
 /// Largest value of the PHY length byte (UM0932 Table 2).
 pub const MAX_LENGTH: usize = 255;
 
-const CRC8: Crc<u8> = Crc::<u8>::new(&CRC_8_SMBUS);
-const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
-const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
+const CRC8: Crc<u8, CrcImpl> = Crc::<u8, CrcImpl>::new(&CRC_8_SMBUS);
+const CRC16: Crc<u16, CrcImpl> = Crc::<u16, CrcImpl>::new(&CRC_16_IBM_3740);
+const CRC32: Crc<u32, CrcImpl> = Crc::<u32, CrcImpl>::new(&CRC_32_ISO_HDLC);
 
 /// The DL CRC of MIB 00h bits 3-4 (UM0932 Table 53; algorithms per
 /// `docs/protocol-notes.md`).

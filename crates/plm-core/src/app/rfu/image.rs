@@ -19,6 +19,7 @@ use super::{image_crc, IMAGE_MAX};
 use crate::app::service::Release;
 use alloc::format;
 use alloc::string::String;
+use crate::CrcImpl;
 use crc::{Crc, CRC_32_ISO_HDLC};
 
 /// Bytes of the interrupt vector table at the start of an image
@@ -66,7 +67,7 @@ fn word(image: &[u8], at: usize) -> u32 {
 
 /// The CRC-32 the descriptor holds: of the image without its 4 bytes.
 fn descriptor_crc(image: &[u8]) -> u32 {
-    let crc = Crc::<u32>::new(&CRC_32_ISO_HDLC);
+    let crc = Crc::<u32, CrcImpl>::new(&CRC_32_ISO_HDLC);
     let mut d = crc.digest();
     d.update(&image[..CRC_AT]);
     d.update(&image[CRC_AT + 4..]);
