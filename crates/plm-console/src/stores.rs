@@ -462,6 +462,12 @@ impl Console {
     /// Sends an ST7580 `command` (the views of what only the ST7580 has);
     /// `reply` gets its outcome, the answer read as an ST7580 command.
     pub fn request(&self, command: Command, reply: impl FnOnce(Outcome<Command>) + 'static) {
+        self.request_boxed(command, Box::new(reply));
+    }
+
+    /// [`Console::request`] for every caller: one copy of the reading of
+    /// the answer in the page, not one per reply closure.
+    fn request_boxed(&self, command: Command, reply: Box<dyn FnOnce(Outcome<Command>)>) {
         self.request_frame(command.to_frame(), move |o| {
             reply(o.read(|f| {
                 Command::from_frame(f).map_err(|e| format!("the modem's answer does not fit: {e}"))
@@ -481,18 +487,39 @@ impl Console {
         f(self.session().borrow().chip())
     }
 
-    /// Sends the request `frame` of a MIB operation on object `index`;
-    /// `done` gets what the answer says ([`Chip::verdict`]), and the modem
-    /// store what the object holds now: the value confirmed (`None`), the
-    /// value written (`Some(Some(data))`), or nothing, erased
-    /// (`Some(None)`).
-    fn mib_request(
-        &self,
-        frame: LocalFrame,
-        index: u16,
-        holds: Option<Option<Vec<u8>>>,
-        done: impl FnOnce(Result<Vec<u8>, String>) + 'static,
-    ) {
+    /// Reads MIB object `index` into the modem store; `done` gets the value
+    /// or what went wrong.
+    pub fn read_mib(&self, index: u16, done: impl FnOnce(MibResult) + 'static) {
+        self.mib_request(MibOp::Read, index, Box::new(done));
+    }
+
+    /// Writes `data` to MIB object `index`; the modem store keeps it once
+    /// confirmed.
+    pub fn write_mib(&self, index: u16, data: Vec<u8>, done: impl FnOnce(MibResult) + 'static) {
+        self.mib_request(MibOp::Write(data), index, Box::new(done));
+    }
+
+    /// Erases MIB object `index` (a chip without erase says so); the
+    /// modem store forgets its value once confirmed.
+    pub fn erase_mib(&self, index: u16, done: impl FnOnce(MibResult) + 'static) {
+        self.mib_request(MibOp::Erase, index, Box::new(done));
+    }
+
+    /// Sends the request of MIB operation `op` on object `index`; `done`
+    /// gets what the answer says ([`Chip::verdict`]), and the modem store
+    /// what the object holds now: the value read or written, or nothing
+    /// once erased. One function for every caller (the callback boxed):
+    /// one copy of it in the page.
+    fn mib_request(&self, op: MibOp, index: u16, done: Box<dyn FnOnce(MibResult)>) {
+        let request = self.with_chip(|c| match &op {
+            MibOp::Read => Ok(c.mib_read(index)),
+            MibOp::Write(data) => Ok(c.mib_write(index, data)),
+            MibOp::Erase => c.mib_erase(index).ok_or(c.name()),
+        });
+        let frame = match request {
+            Ok(frame) => frame,
+            Err(chip) => return done(Err(format!("the {chip} has no MIB erase"))),
+        };
         let (c, mib) = (*self, self.modem.mib);
         self.request_frame(frame, move |o| {
             let got = match o {
@@ -503,41 +530,14 @@ impl Console {
                 Outcome::Failed(why) => Err(why),
             };
             if let Ok(value) = &got {
-                match holds.unwrap_or_else(|| Some(value.clone())) {
-                    Some(v) => mib.update(|m| m.insert(index, v)),
-                    None => mib.update(|m| m.remove(index)),
+                match op {
+                    MibOp::Read => mib.update(|m| m.insert(index, value.clone())),
+                    MibOp::Write(data) => mib.update(|m| m.insert(index, data)),
+                    MibOp::Erase => mib.update(|m| m.remove(index)),
                 }
             }
             done(got)
         });
-    }
-
-    /// Reads MIB object `index` into the modem store; `done` gets the value
-    /// or what went wrong.
-    pub fn read_mib(&self, index: u16, done: impl FnOnce(Result<Vec<u8>, String>) + 'static) {
-        let frame = self.with_chip(|c| c.mib_read(index));
-        self.mib_request(frame, index, None, done);
-    }
-
-    /// Writes `data` to MIB object `index`; the modem store keeps it once
-    /// confirmed.
-    pub fn write_mib(
-        &self,
-        index: u16,
-        data: Vec<u8>,
-        done: impl FnOnce(Result<Vec<u8>, String>) + 'static,
-    ) {
-        let frame = self.with_chip(|c| c.mib_write(index, &data));
-        self.mib_request(frame, index, Some(Some(data)), done);
-    }
-
-    /// Erases MIB object `index` (a chip without erase says so); the
-    /// modem store forgets its value once confirmed.
-    pub fn erase_mib(&self, index: u16, done: impl FnOnce(Result<Vec<u8>, String>) + 'static) {
-        match self.with_chip(|c| c.mib_erase(index).ok_or(c.name())) {
-            Ok(frame) => self.mib_request(frame, index, Some(None), done),
-            Err(chip) => done(Err(format!("the {chip} has no MIB erase"))),
-        }
     }
 
     /// Does something to the simulated world, if that is what is connected.
@@ -801,3 +801,14 @@ fn set_if_changed<T: PartialEq + Send + Sync + 'static>(signal: RwSignal<T>, val
         signal.set(value);
     }
 }
+
+/// What a MIB request's callback gets: the object's data, or why not.
+pub type MibResult = Result<Vec<u8>, String>;
+
+/// A MIB operation of [`Console::mib_request`].
+enum MibOp {
+    Read,
+    Write(Vec<u8>),
+    Erase,
+}
+
