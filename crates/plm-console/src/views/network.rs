@@ -19,6 +19,11 @@ use plm_core::st7570::Command;
 /// Sends an ST7570 `command`; `done` gets the answer read in the access
 /// layer the modem is in, or why there is none.
 pub fn send(c: Console, command: Command, done: impl FnOnce(Result<Command, String>) + 'static) {
+    send_boxed(c, command, Box::new(done));
+}
+
+/// [`send`] for every caller: one copy of the reading of the answer.
+fn send_boxed(c: Console, command: Command, done: Box<dyn FnOnce(Result<Command, String>)>) {
     let layer = c.modem.network.with_untracked(|n| n.layer());
     c.request_frame(command.to_frame(), move |o| {
         done(
