@@ -174,7 +174,8 @@ pub fn UpdateView() -> impl IntoView {
             </div>
             <p
                 id="update-image"
-                class=move || if chosen.with(|c| matches!(c, Some(Chosen { check: Err(_), .. }))) { "message error" } else { "message" }
+                class="message"
+                class:error=move || chosen.with(|c| matches!(c, Some(Chosen { check: Err(_), .. })))
             >
                 {move || chosen.with(|c| c.as_ref().map_or("no image chosen".into(), Chosen::words))}
             </p>
@@ -371,6 +372,6 @@ fn Progress() -> impl IntoView {
                     </table>
                 </div>
             </div>
-        })
+        }.into_any())
     }
 }
