@@ -109,6 +109,22 @@ test('dim one lamp and see its power follow; dim all by broadcast', async (t) =>
     LAMPS,
     { timeout: 60_000, polling: 250 },
   );
+
+  // Two lamps picked by their checkboxes (the row's page stays as it was),
+  // dimmed as a selection, and picked off again.
+  for (const n of [2, 4]) await row(page, n).locator('td.pick input').check();
+  await page.locator('#street-dim-selected', { hasText: 'Dim selected (2)' }).waitFor();
+  await page.locator('#lamp-panel h3', { hasText: lamp(3) }).waitFor();
+  await page.fill('#street-dim-level', '60');
+  await page.click('#street-dim-selected');
+  await page.locator('#street-message', { hasText: 'dimming 60 % sent to 2 lamp(s)' }).waitFor();
+  await page.waitForFunction(
+    (sel) => Number(document.querySelector(sel)?.textContent) === 60,
+    `#fleet-table tr[data-address="${lamp(4)}"] td[data-key="dimming"]`,
+    { timeout: 60_000, polling: 250 },
+  );
+  await row(page, 2).locator('td.pick input').uncheck();
+  await page.locator('#street-dim-selected', { hasText: 'Dim selected (1)' }).waitFor();
 });
 
 test('a failed lamp and an unreachable one are raised as alerts', async (t) => {

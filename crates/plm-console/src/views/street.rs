@@ -110,7 +110,32 @@ pub fn StreetView() -> impl IntoView {
                                     .map(IntoAny::into_any).collect_view()}
                             </tr>
                         </thead>
-                        <tbody>
+                        // One click and one change listener for every row: a row
+                        // is its cells written as HTML (`row_html`), redrawn when
+                        // its lamp or its selection changes.
+                        <tbody
+                            on:click=on_click(move |ev| {
+                                let target = event_element(&ev);
+                                let in_pick = target.as_ref().and_then(|t| t.closest("td.pick").ok().flatten());
+                                if in_pick.is_none() {
+                                    if let Some(a) = target.as_ref().and_then(row_address) {
+                                        focus.set(Some(a));
+                                    }
+                                }
+                            })
+                            on:change=on_event(move |ev| {
+                                let Some(a) = event_element(&ev).as_ref().and_then(row_address) else {
+                                    return;
+                                };
+                                let on = event_target_checked(&ev);
+                                selected.update(|s| {
+                                    s.retain(|x| *x != a);
+                                    if on {
+                                        s.push(a);
+                                    }
+                                });
+                            })
+                        >
                             {super::widgets::keyed_rows(
                                 move || rows.with(|r| r.iter().map(|r| row_key(r.address)).collect()),
                                 move |key| {
@@ -125,38 +150,11 @@ pub fn StreetView() -> impl IntoView {
                                             data-address=address.to_string()
                                             class:trouble=move || row.with(|r| r.as_ref().is_some_and(|r| r.trouble))
                                             class:selected=move || focus.get() == Some(address)
-                                            on:click=on_click(move |_| focus.set(Some(address)))
-                                        >
-                                            <td on:click=on_click(|ev| ev.stop_propagation())>
-                                                <input
-                                                    type="checkbox"
-                                                    prop:checked=move || selected.with(|s| s.contains(&address))
-                                                    on:change=on_event(move |ev| {
-                                                        let on = event_target_checked(&ev);
-                                                        selected.update(|s| {
-                                                            s.retain(|a| *a != address);
-                                                            if on { s.push(address); }
-                                                        });
-                                                    })
-                                                />
-                                            </td>
-                                            {COLUMNS
-                                                .iter()
-                                                .map(|(key, _)| {
-                                                    let key = *key;
-                                                    let cell = move || row.with(|r| match r.as_ref().map(|r| r.cell(key)) {
-                                                        Some(c) if !c.is_empty() => c,
-                                                        _ => "–".to_string(),
-                                                    });
-                                                    let cls = move || match key {
-                                                        "state" => row.with(|r| r.as_ref().map_or("", |r| fleet::state_class(&r.state))),
-                                                        "address" | "firmware" => "hex",
-                                                        _ => "num",
-                                                    };
-                                                    view! { <td class=cls data-key=key>{cell}</td> }
-                                                })
-                                                .map(IntoAny::into_any).collect_view()}
-                                        </tr>
+                                            inner_html=move || {
+                                                let picked = selected.with(|s| s.contains(&address));
+                                                row.with(|r| row_html(r.as_ref(), picked))
+                                            }
+                                        ></tr>
                                     }
                                     .into_any()
                                 },
@@ -334,6 +332,41 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
             </div>
         }).map(IntoAny::into_any)}
     }
+}
+
+/// A fleet row's cells as HTML: the selection checkbox, then each of
+/// [`COLUMNS`] (`–` where the lamp has no value yet).
+fn row_html(row: Option<&Row>, picked: bool) -> String {
+    let mut html = format!(
+        "<td class=\"pick\"><input type=\"checkbox\"{}></td>",
+        if picked { " checked" } else { "" }
+    );
+    for (key, _) in COLUMNS {
+        let class = match *key {
+            "state" => row.map_or("", |r| fleet::state_class(&r.state)),
+            "address" | "firmware" => "hex",
+            _ => "num",
+        };
+        let cell = row.map(|r| r.cell(key)).filter(|c| !c.is_empty());
+        html.push_str(&format!(
+            "<td class=\"{class}\" data-key=\"{key}\">{}</td>",
+            super::widgets::escape(cell.as_deref().unwrap_or("–"))
+        ));
+    }
+    html
+}
+
+/// The element an event happened on.
+fn event_element(ev: &web_sys::Event) -> Option<web_sys::Element> {
+    use wasm_bindgen::JsCast;
+    ev.target()?.dyn_into().ok()
+}
+
+/// The lamp of the fleet row holding `element` (its `data-address`).
+fn row_address(element: &web_sys::Element) -> Option<Address> {
+    let row = element.closest("tr[data-address]").ok()??;
+    let hex = row.get_attribute("data-address")?;
+    u64::from_str_radix(&hex, 16).ok().map(key_address)
 }
 
 /// A board address as the key of its row (6 bytes in a u64), and back.
