@@ -61,6 +61,14 @@ test('the ST7570 is chosen in the connection bar, remembered, and configured as 
   const all = await titles(page);
   assert.ok(all.includes('CMD_WriteDBRequest'), all.join(', '));
   assert.ok(all.includes('CMD_ReadDBConfirm'), all.join(', '));
+  // The command filter offers the ST7570's commands, not the ST7580's.
+  assert.equal(await page.locator('#filter-command option[value="MIB_WriteRequest"]').count(), 0);
+  await page.selectOption('#filter-command', 'CMD_WriteDBRequest');
+  await page.waitForFunction(() => {
+    const t = [...document.querySelectorAll('#traffic-table tbody td.title')].map((c) => c.textContent);
+    return t.length > 0 && t.every((x) => x.startsWith('CMD_WriteDBRequest'));
+  });
+  await page.selectOption('#filter-command', '');
   await shot(page, 'st7570-traffic');
 
   // The chip is remembered: a reload opens on the ST7570 again.

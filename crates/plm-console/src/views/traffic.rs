@@ -8,7 +8,6 @@ use crate::app::Tab;
 use crate::stores::use_console;
 use crate::traffic::{Entry, Filter, CAPACITY};
 use leptos::prelude::*;
-use plm_core::st7580::code;
 use std::sync::Arc;
 
 /// Rows rendered at most; the log keeps [`CAPACITY`].
@@ -134,7 +133,24 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
 
 #[component]
 fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
-    let commands: Vec<&'static str> = code::ALL.iter().map(|(_, n, _)| *n).collect();
+    let c = use_console();
+    // The commands of the chip the profile talks to, by its description's
+    // names; a command the new chip does not have stops filtering.
+    let commands = move || {
+        let chip = plm_core::chip::for_dialect(c.profile.get().dialect());
+        let chosen = filter.with_untracked(|f| f.command.clone());
+        let mut html = String::from("<option value=\"\">all</option>");
+        let mut kept = chosen.is_empty();
+        for name in (0..=255u8).filter_map(|code| chip.code_name(code)) {
+            let selected = if name == chosen { " selected" } else { "" };
+            kept |= name == chosen;
+            html.push_str(&format!("<option value=\"{name}\"{selected}>{name}</option>"));
+        }
+        if !kept {
+            filter.update(|f| f.command.clear());
+        }
+        html
+    };
     view! {
         <label>
             "Way "
@@ -165,11 +181,9 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Command "
             <select
                 id="filter-command"
+                inner_html=commands
                 on:change=on_event(move |ev| filter.update(|f| f.command = event_target_value(&ev)))
-            >
-                <option value="">"all"</option>
-                {commands.into_iter().map(|n| view! { <option value=n>{n}</option> }).map(IntoAny::into_any).collect_view()}
-            </select>
+            ></select>
         </label>
     }
 }
