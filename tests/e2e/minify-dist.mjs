@@ -1,5 +1,6 @@
 // Minifies the JavaScript of a release build in dist/ (the wasm-bindgen
-// glue and the service worker) with terser, gives the wasm's imports and
+// glue, without the stream classes the wasm no longer exports, and the
+// service worker) with terser, gives the wasm's imports and
 // exports between it and the glue short names (short-names.mjs), and
 // rewrites the Subresource Integrity hashes index.html gives for them. `cargo xtask dist` runs it
 // after Trunk: the console's 350 KiB budget counts every JS file, and
@@ -19,6 +20,23 @@ const here = path.dirname(fileURLToPath(import.meta.url));
 const dist = path.resolve(process.argv[2] ?? path.join(here, '../../dist'));
 const sri = (body) => `sha384-${crypto.createHash('sha384').update(body).digest('base64')}`;
 
+/**
+ * The glue without the wasm-streams classes (IntoUnderlyingSource, -Sink,
+ * -ByteSource) that Leptos's server functions bring and the console never
+ * uses: index.html's wasm-opt options stop exporting them from the wasm.
+ * Each is the class, its `Symbol.dispose` line and its finalization
+ * registry, as wasm-bindgen writes them; anything of them left over is an
+ * error (a new wasm-bindgen writing them otherwise).
+ */
+function dropStreamClasses(js) {
+  const out = js
+    .replace(/^export class IntoUnderlying\w+ \{\n[\s\S]*?^\}\n/gm, '')
+    .replace(/^if \(Symbol\.dispose\) IntoUnderlying\w+\.prototype\[Symbol\.dispose\] = .*\n/gm, '')
+    .replace(/^const IntoUnderlying\w+Finalization = [^;]*;\n/gm, '');
+  if (/intounderlying/i.test(out)) throw new Error('minify-dist: the glue still names the wasm-streams classes');
+  return out;
+}
+
 let html = await fs.readFile(path.join(dist, 'index.html'), 'utf8');
 for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sort()) {
   const file = path.join(dist, name);
@@ -26,6 +44,7 @@ for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sor
   let before = original;
   // The service worker is a classic script; the wasm-bindgen glue a module.
   const module = name !== 'sw.js';
+  if (module) before = dropStreamClasses(before);
   const wasmFile = path.join(dist, name.replace(/\.js$/, '_bg.wasm'));
   const wasm = module ? await fs.readFile(wasmFile).catch(() => null) : null;
   if (wasm) {
