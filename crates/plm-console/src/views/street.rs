@@ -140,19 +140,21 @@ pub fn StreetView() -> impl IntoView {
                                 move || rows.with(|r| r.iter().map(|r| row_key(r.address)).collect()),
                                 move |key| {
                                     let address = key_address(key);
+                                    // At most one row, in a memo of the table's own type
+                                    // (a memo type of its own costs the page its code).
                                     let row = Memo::new(move |_| {
                                         street.version.track();
                                         let now = street.now.get();
-                                        street.with_fleet(|f| f.get(&address).map(|l| Row::of(l, now)))
+                                        street.with_fleet(|f| f.get(&address).map(|l| Row::of(l, now)).into_iter().collect::<Vec<_>>())
                                     });
                                     view! {
                                         <tr
                                             data-address=address.to_string()
-                                            class:trouble=move || row.with(|r| r.as_ref().is_some_and(|r| r.trouble))
+                                            class:trouble=move || row.with(|r| r.first().is_some_and(|r| r.trouble))
                                             class:selected=move || focus.get() == Some(address)
                                             inner_html=move || {
                                                 let picked = selected.with(|s| s.contains(&address));
-                                                row.with(|r| row_html(r.as_ref(), picked))
+                                                row.with(|r| row_html(r.first(), picked))
                                             }
                                         ></tr>
                                     }
