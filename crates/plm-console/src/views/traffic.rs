@@ -17,7 +17,13 @@ pub const MAX_ROWS: usize = 500;
 #[component]
 pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
     let c = use_console();
-    let filter = crate::views::widgets::signal(Filter::default());
+    // The filter's three choices as String signals (a signal type the page
+    // has, rather than one of `Filter`'s own).
+    let filter = FilterChoice {
+        from: crate::views::widgets::signal(String::new()),
+        kind: crate::views::widgets::signal(String::new()),
+        command: crate::views::widgets::signal(String::new()),
+    };
     let selected = crate::views::widgets::signal(None::<u64>);
     let message = crate::views::widgets::signal(None::<String>);
     // Hidden, the table keeps its rows and does not even look at the log:
@@ -131,14 +137,33 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
     }
 }
 
+/// The filter as chosen in the toolbar.
+#[derive(Clone, Copy)]
+struct FilterChoice {
+    from: RwSignal<String>,
+    kind: RwSignal<String>,
+    command: RwSignal<String>,
+}
+
+impl FilterChoice {
+    /// The filter now (tracked).
+    fn get(&self) -> Filter {
+        Filter {
+            from: self.from.get(),
+            kind: self.kind.get(),
+            command: self.command.get(),
+        }
+    }
+}
+
 #[component]
-fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
+fn FilterControls(filter: FilterChoice) -> impl IntoView {
     let c = use_console();
     // The commands of the chip the profile talks to, by its description's
     // names; a command the new chip does not have stops filtering.
     let commands = move || {
         let chip = plm_core::chip::for_dialect(c.profile.get().dialect());
-        let chosen = filter.with_untracked(|f| f.command.clone());
+        let chosen = filter.command.get_untracked();
         let mut html = String::from("<option value=\"\">all</option>");
         let mut kept = chosen.is_empty();
         for name in (0..=255u8).filter_map(|code| chip.code_name(code)) {
@@ -147,7 +172,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             html.push_str(&format!("<option value=\"{name}\"{selected}>{name}</option>"));
         }
         if !kept {
-            filter.update(|f| f.command.clear());
+            filter.command.set(String::new());
         }
         html
     };
@@ -156,7 +181,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Way "
             <select
                 id="filter-from"
-                on:change=on_event(move |ev| filter.update(|f| f.from = event_target_value(&ev)))
+                on:change=on_event(move |ev| filter.from.set(event_target_value(&ev)))
             >
                 <option value="">"both"</option>
                 <option value="host">"host → modem"</option>
@@ -167,7 +192,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             "Kind "
             <select
                 id="filter-kind"
-                on:change=on_event(move |ev| filter.update(|f| f.kind = event_target_value(&ev)))
+                on:change=on_event(move |ev| filter.kind.set(event_target_value(&ev)))
             >
                 <option value="">"all"</option>
                 <option value="frame">"frames"</option>
@@ -182,7 +207,7 @@ fn FilterControls(filter: RwSignal<Filter>) -> impl IntoView {
             <select
                 id="filter-command"
                 inner_html=commands
-                on:change=on_event(move |ev| filter.update(|f| f.command = event_target_value(&ev)))
+                on:change=on_event(move |ev| filter.command.set(event_target_value(&ev)))
             ></select>
         </label>
     }
