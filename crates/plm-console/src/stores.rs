@@ -99,14 +99,15 @@ pub struct SimStore {
     /// Lamps on the simulated street.
     pub lamps: RwSignal<usize>,
     /// Random lamp failures per lamp per lit hour on the simulated street
-    /// (0: none); kept when the street restarts.
-    pub failure_rate: RwSignal<f64>,
+    /// (0: none); kept when the street restarts. The `f64`'s bits: a
+    /// signal type the page has (each type brings its own code).
+    pub failure_rate: RwSignal<u64>,
     /// Whether the simulated cable is plugged in.
     pub plugged: RwSignal<bool>,
     /// Frames echoed by the peers.
     pub echoed: RwSignal<u64>,
     /// Recent power line events, in words, newest last.
-    pub line_events: RwSignal<VecDeque<String>>,
+    pub line_events: RwSignal<Vec<String>>,
     /// How much faster than the page's clock a simulated street runs
     /// (`?speed=N`, demos and tests; 1 by default).
     pub speed: RwSignal<u32>,
@@ -255,10 +256,10 @@ pub fn provide_console() -> Console {
         sim: SimStore {
             nodes: crate::views::widgets::signal(1),
             lamps: crate::views::widgets::signal(STREET_LAMPS),
-            failure_rate: crate::views::widgets::signal(0.0),
+            failure_rate: crate::views::widgets::signal(0f64.to_bits()),
             plugged: crate::views::widgets::signal(true),
             echoed: crate::views::widgets::signal(0),
-            line_events: crate::views::widgets::signal(VecDeque::new()),
+            line_events: crate::views::widgets::signal(Vec::new()),
             servers: crate::views::widgets::signal(Vec::new()),
             speed: crate::views::widgets::signal(1),
         },
@@ -316,7 +317,7 @@ impl Console {
                 baud,
                 SIM_SEED,
             );
-            street.set_failure_rate(self.sim.failure_rate.get_untracked());
+            street.set_failure_rate(f64::from_bits(self.sim.failure_rate.get_untracked()));
             Box::new(street)
         } else if profile == Profile::St7570 {
             Box::new(crate::transport::sfsk::SfskTransport::new(
@@ -331,7 +332,7 @@ impl Console {
                 SIM_SEED,
             ))
         };
-        self.sim.line_events.set(VecDeque::new());
+        self.sim.line_events.set(Vec::new());
         self.connect_transport(t);
         let speed = self.sim.speed.get_untracked();
         self.street.act(|s| s.set_speed(speed));
@@ -669,9 +670,9 @@ impl Console {
         if !events.is_empty() {
             self.sim.line_events.update(|l| {
                 for e in events {
-                    l.push_back(crate::views::simulator::describe_line_event(&e));
+                    l.push(crate::views::simulator::describe_line_event(&e));
                     if l.len() > LINE_EVENTS {
-                        l.pop_front();
+                        l.remove(0);
                     }
                 }
             });

@@ -11,7 +11,7 @@ use plm_core::app::service::Service;
 use plm_core::app::{Address, Message, Request};
 
 /// Eight checkboxes, IO7 first, bound to the bits of `mask`.
-fn pin_boxes(mask: RwSignal<u8>, id: &'static str) -> impl IntoView {
+fn pin_boxes(mask: RwSignal<u32>, id: &'static str) -> impl IntoView {
     (0..8u8)
         .rev()
         .map(|bit| {
@@ -79,9 +79,10 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
             .get()
             .and_then(|a| street.with_fleet(|f| f.get(&a).cloned()))
     });
-    let io_config = crate::views::widgets::signal(0u8);
-    let outputs = crate::views::widgets::signal(0u8);
-    let group = crate::views::widgets::signal(2u8);
+    // u32 signals (a type the page has) holding bytes.
+    let io_config = crate::views::widgets::signal(0u32);
+    let outputs = crate::views::widgets::signal(0u32);
+    let group = crate::views::widgets::signal(2u32);
     let params = crate::views::widgets::signal(String::new());
     let ask = move |m: Message, what: &'static str| {
         let Some(a) = focus.get_untracked() else {
@@ -98,7 +99,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             format!("GPIO levels: {v:08b} (IO7…IO0)")
                         }
                         Ok(Message::Service(Service::IoConfig(v))) => {
-                            io_config.set(v);
+                            io_config.set(v.into());
                             format!("GPIO outputs: {v:08b} (IO7…IO0, 1 = output)")
                         }
                         Ok(Message::Service(Service::Params { group, data })) => {
@@ -189,13 +190,13 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             <span class="muted">"output"</span>
                             {pin_boxes(io_config, "io-config")}
                             {button("", "Read", "", move || ask(Message::Service(Service::IoConfigGet), "read GPIO configuration"))}
-                            {button("lamp-io-config", "Set", "", move || ask(Message::Service(Service::IoConfigSet(io_config.get_untracked())), "set GPIO configuration"))}
+                            {button("lamp-io-config", "Set", "", move || ask(Message::Service(Service::IoConfigSet(io_config.get_untracked() as u8)), "set GPIO configuration"))}
                         </div>
                         <div class="form-row pins">
                             <span class="muted">"level"</span>
                             {pin_boxes(outputs, "io-out")}
                             {button("lamp-io-out", "Set outputs", "", move || {
-                                match output_levels(io_config.get_untracked(), outputs.get_untracked()) {
+                                match output_levels(io_config.get_untracked() as u8, outputs.get_untracked() as u8) {
                                     Ok(v) => ask(Message::Service(Service::OutputsSet(v)), "set GPIO outputs"),
                                     Err(e) => note.set(Some(e)),
                                 }
@@ -208,13 +209,13 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                                     <option value=i.to_string() selected=i == 2>{*n}</option>
                                 }).map(IntoAny::into_any).collect_view()}
                             </select>
-                            {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() }), "read parameters"))}
+                            {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() as u8 }), "read parameters"))}
                             {button("lamp-params-write", "Write", "", move || {
                                 let data = match plm_core::hex::parse(&params.get_untracked()) {
                                     Ok(d) => d,
                                     Err(e) => return note.set(Some(format!("nothing sent: {e}"))),
                                 };
-                                ask(Message::Service(Service::ParamSet { group: group.get_untracked(), data }), "write parameters")
+                                ask(Message::Service(Service::ParamSet { group: group.get_untracked() as u8, data }), "write parameters")
                             })}
                         </div>
                         {text_input("lamp-params", "payload hex", "32 bytes, hex", None, params)}

@@ -114,11 +114,11 @@ fn StreetCard() -> impl IntoView {
 #[component]
 fn FailureRate() -> impl IntoView {
     let c = use_console();
-    let text = crate::views::widgets::signal(super::fixed(c.sim.failure_rate.get_untracked(), 2));
+    let text = crate::views::widgets::signal(super::fixed(f64::from_bits(c.sim.failure_rate.get_untracked()), 2));
     let message = crate::views::widgets::signal(None::<String>);
     let apply = move || match super::decimal(&text.get_untracked()) {
         Some(rate) if (0.0..=60.0).contains(&rate) => {
-            c.sim.failure_rate.set(rate);
+            c.sim.failure_rate.set(rate.to_bits());
             c.with_simulator(|s| s.set_failure_rate(rate));
             message.set(Some(if rate == 0.0 {
                 "no random failures".to_string()
@@ -291,7 +291,9 @@ fn LineCard() -> impl IntoView {
 #[component]
 fn UartCard() -> impl IntoView {
     let c = use_console();
-    let dir = crate::views::widgets::signal(Dir::HostToModem);
+    // Modem to host when set (a bool: a signal type the page has).
+    let up = crate::views::widgets::signal(false);
+    let dir = move || if up.get_untracked() { Dir::ModemToHost } else { Dir::HostToModem };
     let drop = crate::views::widgets::signal("0".to_string());
     let corrupt = crate::views::widgets::signal("0".to_string());
     let delay = crate::views::widgets::signal("0".to_string());
@@ -309,7 +311,7 @@ fn UartCard() -> impl IntoView {
             message.set(Some("percentages from 0 to 100".into()));
             return;
         };
-        let d = dir.get_untracked();
+        let d = dir();
         c.with_simulator(|s| {
             s.set_byte_faults(
                 d,
@@ -331,7 +333,7 @@ fn UartCard() -> impl IntoView {
                 <select
                     id="sim-dir"
                     on:change=on_event(move |ev| {
-                        dir.set(if event_target_value(&ev) == "up" { Dir::ModemToHost } else { Dir::HostToModem })
+                        up.set(event_target_value(&ev) == "up")
                     })
                 >
                     <option value="down" selected>"host → modem"</option>
@@ -339,9 +341,9 @@ fn UartCard() -> impl IntoView {
                 </select>
             </label>
             <div class="buttons">
-                {button("sim-drop", "Drop next byte", "", move || inject(Fault::DropByte(dir.get_untracked())))}
-                {button("sim-corrupt", "Corrupt next byte", "", move || inject(Fault::CorruptByte(dir.get_untracked(), 0x10)))}
-                {button("sim-delay", "Delay next byte 15 ms", "", move || inject(Fault::DelayByte(dir.get_untracked(), 15 * MS)))}
+                {button("sim-drop", "Drop next byte", "", move || inject(Fault::DropByte(dir())))}
+                {button("sim-corrupt", "Corrupt next byte", "", move || inject(Fault::CorruptByte(dir(), 0x10)))}
+                {button("sim-delay", "Delay next byte 15 ms", "", move || inject(Fault::DelayByte(dir(), 15 * MS)))}
             </div>
             <p class="muted">"At random, for every byte this way:"</p>
             {text_field("drop % ", "sim-p-drop", 4, drop)}
