@@ -382,27 +382,18 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
             <p class="muted">
                 "Data and sniffer indications from the modem (UM0932 Table 39). With echoing peers (Simulator view) every frame sent comes back."
             </p>
-            {move || {
+            // The plot, or why there is none, written as HTML in one go.
+            <div inner_html=move || {
                 rows.with(|r| match snr_plot::layout(&snr_points(r)) {
-                    Some(plot) => snr_plot::draw(plot).into_any(),
+                    Some(plot) => snr_plot::draw(&plot),
                     None if r.is_empty() => {
-                        view! {
-                            <p class="muted" id="snr-plot-empty">
-                                "No indications yet: send a frame with echoing peers (Simulator view)."
-                            </p>
-                        }
-                            .into_any()
+                        "<p class=\"muted\" id=\"snr-plot-empty\">No indications yet: send a frame with echoing peers (Simulator view).</p>".to_string()
                     }
                     None => {
-                        view! {
-                            <p class="muted" id="snr-plot-empty">
-                                "No SNR to plot: B-FSK frames carry none, and imported entries may have no time."
-                            </p>
-                        }
-                            .into_any()
+                        "<p class=\"muted\" id=\"snr-plot-empty\">No SNR to plot: B-FSK frames carry none, and imported entries may have no time.</p>".to_string()
                     }
                 })
-            }}
+            }></div>
             // At most INDICATION_ROWS rows, rewritten when one arrives.
             {text_table("indications-table", INDICATION_COLUMNS, Box::new(move || {
                 rows.get()
