@@ -7,11 +7,11 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
-use super::widgets::{action_button, button, on_event};
+use super::widgets::{action_button, button, escape, on_event};
 use crate::mibform::{self, Problems};
 use crate::stores::use_console;
 use leptos::prelude::*;
-use plm_core::field::{Field, Kind};
+use plm_core::field::Kind;
 use plm_core::mib::Object;
 use plm_core::st7580::mib::index;
 use std::rc::Rc;
@@ -224,7 +224,6 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
     });
     let problems = crate::views::widgets::signal(Problems::default());
     let reveal = crate::views::widgets::signal(false);
-    let masked = Signal::derive(move || secret && !reveal.get());
     let base = move || {
         read_value
             .get_untracked()
@@ -293,20 +292,6 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
         problems.set(Problems::default());
         status.set("factory default loaded into the form: Write to send it".into());
     };
-    let diff = move || {
-        let v = read_value.get()?;
-        let d = mibform::differences(object, &v, object.default);
-        Some(if d.is_empty() {
-            "equal to the factory default".to_string()
-        } else {
-            let names: Vec<_> = d.iter().map(|f| f.label).collect();
-            format!(
-                "{} field(s) differ from the factory default: {}",
-                d.len(),
-                names.join(", ")
-            )
-        })
-    };
     let writable = object.access.write;
 
     view! {
@@ -348,170 +333,167 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                         }
                     })}
             </div>
-            <p class="status" data-role="status">{move || status.get()}</p>
-            {move || {
-                problems
-                    .with(|p| p.object.clone())
-                    .map(|o| view! { <p class="problem">{o}</p> })
-            }}
-            <table class="fields">
-                <thead>
-                    <tr>
-                        <th>"Field"</th>
-                        <th>"Value"</th>
-                        <th>"Allowed"</th>
-                        <th>"Factory default"</th>
-                        <th></th>
-                    </tr>
-                </thead>
-                <tbody>
-                    {object
-                        .fields
-                        .iter()
-                        .map(|f| {
-                            view! {
-                                <FieldRow
-                                    field=f
-                                    object=object
-                                    read_value=read_value
-                                    inputs=inputs
-                                    problems=problems
-                                    masked=masked
-                                    editable=writable && f.settable
-                                />
-                            }
-                        })
-                        .map(IntoAny::into_any).collect_view()}
-                </tbody>
-            </table>
-            <p class="diff" data-role="diff">{diff}</p>
+            // Status, the form and what differs, written as HTML in one go;
+            // what is typed goes to `inputs` untracked (the form is not
+            // rewritten under the typing), read back by the delegated
+            // listener from the input's `name`.
+            <div
+                inner_html=move || {
+                    card_html(
+                        object,
+                        &status.get(),
+                        &problems.get(),
+                        read_value.get().as_deref(),
+                        &inputs.get(),
+                        secret && !reveal.get(),
+                    )
+                }
+                on:input=on_event(move |ev| typed(object, inputs, &ev))
+            ></div>
         </article>
     }
 }
 
-/// One field: label, input (or value), what is allowed, the factory
-/// default, and why the form refused it.
-#[component]
-fn FieldRow(
-    field: &'static Field,
-    object: &'static Object,
-    read_value: Memo<Option<Vec<u8>>>,
-    inputs: RwSignal<Inputs>,
-    problems: RwSignal<Problems>,
-    masked: Signal<bool>,
-    editable: bool,
-) -> impl IntoView {
-    let name = field.name;
-    let current = move || read_value.get().unwrap_or_else(|| object.default.to_vec());
-    // Reserved and unused bits are shown only when they are not zero.
-    let visible = move || field.settable || field.get(&current()).is_some_and(|v| v != 0);
-    let differs = move || {
-        read_value
-            .get()
-            .is_some_and(|v| field.read(&v) != field.read(object.default))
+/// What is typed into a field's input (found by its `name`), into
+/// `inputs` without redrawing the form.
+fn typed(object: &'static Object, inputs: RwSignal<Inputs>, ev: &web_sys::Event) {
+    use wasm_bindgen::JsCast;
+    let name = ev
+        .target()
+        .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+        .and_then(|e| e.get_attribute("name"))
+        .unwrap_or_default();
+    let Some(field) = object.fields.iter().find(|f| f.name == name) else {
+        return;
     };
-    let secret = move |text: String| {
-        if masked.get() {
-            "••••••••".to_string()
-        } else {
-            text
-        }
+    let text = match field.kind {
+        Kind::Flag => String::from(if event_target_checked(ev) { "1" } else { "0" }),
+        _ => event_target_value(ev),
     };
-    let allowed = match field.kind {
-        Kind::Bytes => format!("{} bytes, hex", field.size),
-        Kind::Flag => "yes / no".to_string(),
-        // The select lists the choices.
-        Kind::Enum(_) if editable => String::new(),
-        _ => field.allowed(),
-    };
-    let value = if editable {
-        field_input(field, inputs, masked).into_any()
-    } else {
-        view! { <span class="value">{move || secret(mibform::show(field, &current()))}</span> }
-            .into_any()
-    };
-    view! {
-        <tr
-            hidden=move || !visible()
-            class:differs=differs
-            class:invalid=move || problems.with(|p| p.fields.contains_key(name))
-            data-field=name
-        >
-            <th>
-                {field.label}
-                {(!field.unit.is_empty()).then(|| format!(" ({})", field.unit))}
-            </th>
-            <td>{value}</td>
-            <td class="muted">{allowed}</td>
-            <td class="muted">{move || secret(mibform::show(field, object.default))}</td>
-            <td class="problem" data-role="problem">
-                {move || problems.with(|p| p.fields.get(name).cloned())}
-            </td>
-        </tr>
-    }
+    inputs.update_untracked(|m| m.insert(field.name, text));
 }
 
-/// The input of an editable field, by its kind.
-fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<bool>) -> AnyView {
-    let name = field.name;
-    let value = move || inputs.with(|m| m.get(name).cloned().unwrap_or_default());
-    let set = move |v: String| {
-        inputs.update(|m| {
-            m.insert(name, v);
-        })
+/// A card's status, refusal, fields table and differences from the
+/// factory default, as HTML: one row per field with its label, input (or
+/// value), what is allowed, the factory default, and why the form refused
+/// it. `read` is the value last read, `masked` hides the key's values.
+fn card_html(
+    object: &'static Object,
+    status: &str,
+    problems: &Problems,
+    read: Option<&[u8]>,
+    inputs: &Inputs,
+    masked: bool,
+) -> String {
+    use std::fmt::Write;
+    let secret = |text: String| {
+        if masked {
+            "••••••••".to_string()
+        } else {
+            escape(&text)
+        }
     };
-    match field.kind {
-        Kind::Enum(names) => view! {
-            <select name=name on:change=on_event(move |ev| set(event_target_value(&ev)))>
-                {names
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, n)| !n.is_empty() && **n != "Reserved")
-                    .map(|(i, n)| {
-                        let raw = i.to_string();
-                        let r = raw.clone();
-                        view! {
-                            <option value=raw selected=move || value() == r>
-                                {n.to_string()}
-                            </option>
-                        }
-                    })
-                    .map(IntoAny::into_any).collect_view()}
-            </select>
-        }
-        .into_any(),
-        Kind::Flag => view! {
-            <input
-                type="checkbox"
-                name=name
-                prop:checked=move || value() == "1"
-                on:change=on_event(move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into()))
-            />
-        }
-        .into_any(),
-        Kind::Bytes => view! {
-            <input
-                type=move || if masked.get() { "password" } else { "text" }
-                class="hex"
-                name=name
-                autocomplete="off"
-                spellcheck="false"
-                size="34"
-                prop:value=value
-                on:input=on_event(move |ev| set(event_target_value(&ev)))
-            />
-        }
-        .into_any(),
-        _ => view! {
-            <input
-                type="text"
-                inputmode="numeric"
-                name=name
-                size="10"
-                prop:value=value
-                on:input=on_event(move |ev| set(event_target_value(&ev)))
-            />
-        }
-        .into_any(),
+    let current = read.unwrap_or(object.default);
+    let mut h = format!("<p class=\"status\" data-role=\"status\">{}</p>", escape(status));
+    if let Some(o) = &problems.object {
+        let _ = write!(h, "<p class=\"problem\">{}</p>", escape(o));
     }
+    h.push_str("<table class=\"fields\"><thead><tr><th>Field</th><th>Value</th><th>Allowed</th><th>Factory default</th><th></th></tr></thead><tbody>");
+    for field in object.fields {
+        let name = field.name;
+        let editable = object.access.write && field.settable;
+        // Reserved and unused bits are shown only when they are not zero.
+        let visible = field.settable || field.get(current).is_some_and(|v| v != 0);
+        let differs = read.is_some_and(|v| field.read(v) != field.read(object.default));
+        let invalid = problems.fields.get(name);
+        let _ = write!(
+            h,
+            "<tr data-field=\"{name}\" class=\"{}{}\"{}><th>{}{}</th><td>",
+            if differs { "differs " } else { "" },
+            if invalid.is_some() { "invalid" } else { "" },
+            if visible { "" } else { " hidden" },
+            escape(field.label),
+            if field.unit.is_empty() {
+                String::new()
+            } else {
+                escape(&format!(" ({})", field.unit))
+            },
+        );
+        let value = escape(&inputs.get(name).cloned().unwrap_or_default());
+        match field.kind {
+            _ if !editable => {
+                let _ = write!(
+                    h,
+                    "<span class=\"value\">{}</span>",
+                    secret(mibform::show(field, current))
+                );
+            }
+            Kind::Enum(names) => {
+                let _ = write!(h, "<select name=\"{name}\">");
+                for (i, n) in names.iter().enumerate() {
+                    if !n.is_empty() && *n != "Reserved" {
+                        let i = i.to_string();
+                        let _ = write!(
+                            h,
+                            "<option value=\"{i}\"{}>{}</option>",
+                            if value == i { " selected" } else { "" },
+                            escape(n)
+                        );
+                    }
+                }
+                h.push_str("</select>");
+            }
+            Kind::Flag => {
+                let _ = write!(
+                    h,
+                    "<input type=\"checkbox\" name=\"{name}\"{}>",
+                    if value == "1" { " checked" } else { "" }
+                );
+            }
+            Kind::Bytes => {
+                let _ = write!(
+                    h,
+                    "<input type=\"{}\" class=\"hex\" name=\"{name}\" autocomplete=\"off\" spellcheck=\"false\" size=\"34\" value=\"{value}\">",
+                    if masked { "password" } else { "text" }
+                );
+            }
+            _ => {
+                let _ = write!(
+                    h,
+                    "<input type=\"text\" inputmode=\"numeric\" name=\"{name}\" size=\"10\" value=\"{value}\">"
+                );
+            }
+        }
+        let allowed = match field.kind {
+            Kind::Bytes => format!("{} bytes, hex", field.size),
+            Kind::Flag => "yes / no".to_string(),
+            // The select lists the choices.
+            Kind::Enum(_) if editable => String::new(),
+            _ => field.allowed(),
+        };
+        let _ = write!(
+            h,
+            "</td><td class=\"muted\">{}</td><td class=\"muted\">{}</td><td class=\"problem\" data-role=\"problem\">{}</td></tr>",
+            escape(&allowed),
+            secret(mibform::show(field, object.default)),
+            escape(invalid.map_or("", |s| s))
+        );
+    }
+    h.push_str("</tbody></table><p class=\"diff\" data-role=\"diff\">");
+    if let Some(v) = read {
+        let d = mibform::differences(object, v, object.default);
+        if d.is_empty() {
+            h.push_str("equal to the factory default");
+        } else {
+            let names: Vec<_> = d.iter().map(|f| f.label).collect();
+            let _ = write!(
+                h,
+                "{} field(s) differ from the factory default: {}",
+                d.len(),
+                escape(&names.join(", "))
+            );
+        }
+    }
+    h.push_str("</p>");
+    h
 }
