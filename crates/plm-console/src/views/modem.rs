@@ -7,7 +7,7 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
-use super::widgets::{action_button, button, escape, on_event};
+use super::widgets::{button, escape, on_click, on_event};
 use crate::mibform::{self, Problems};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -292,47 +292,23 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
         problems.set(Problems::default());
         status.set("factory default loaded into the form: Write to send it".into());
     };
-    let writable = object.access.write;
-
     view! {
         <article class="card mib" id=format!("mib-{}", mibform::index_text(dialect, idx).to_ascii_lowercase())>
-            <header>
-                <h3>
-                    <span class="index">{format!("{}h", mibform::index_text(dialect, idx))}</span>
-                    " "
-                    {object.name}
-                </h3>
-                <span class="access" title="Access">{object.access.label()}</span>
-                <span class="muted">{object.section}</span>
-            </header>
-            <div class="actions">
-                {object.access.read.then(|| action_button("read", "Read", read))}
-                {writable
-                    .then(|| {
-                        view! {
-                            {action_button("write", "Write", write)}
-                            {action_button("default", "Factory default", load_default)}
-                        }
-                    })}
-                {object
-                    .access
-                    .erase
-                    .then(|| action_button("erase", "Erase", erase))}
-                {secret
-                    .then(|| {
-                        view! {
-                            <label class="reveal">
-                                <input
-                                    type="checkbox"
-                                    data-action="reveal"
-                                    prop:checked=move || reveal.get()
-                                    on:change=on_event(move |ev| reveal.set(event_target_checked(&ev)))
-                                />
-                                " Reveal key"
-                            </label>
-                        }
-                    })}
-            </div>
+            <header inner_html=header_html(object, dialect)></header>
+            // The actions as HTML, their clicks handled by one listener
+            // by the `data-action` clicked.
+            <div
+                class="actions"
+                inner_html=actions_html(object, secret)
+                on:click=on_click(move |ev| match action_of(&ev).as_str() {
+                    "read" => read(),
+                    "write" => write(),
+                    "default" => load_default(),
+                    "erase" => erase(),
+                    "reveal" => reveal.set(event_target_checked(&ev)),
+                    _ => {}
+                })
+            ></div>
             // Status, the form and what differs, written as HTML in one go;
             // what is typed goes to `inputs` untracked (the form is not
             // rewritten under the typing), read back by the delegated
@@ -352,6 +328,49 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             ></div>
         </article>
     }
+}
+
+/// A card's heading: index, name, access and where the manual has it.
+fn header_html(object: &'static Object, dialect: plm_core::link::Dialect) -> String {
+    format!(
+        "<h3><span class=\"index\">{}h</span> {}</h3><span class=\"access\" title=\"Access\">{}</span><span class=\"muted\">{}</span>",
+        mibform::index_text(dialect, object.index),
+        escape(object.name),
+        escape(object.access.label()),
+        escape(object.section)
+    )
+}
+
+/// A card's buttons, by what the object allows, and the key's Reveal.
+fn actions_html(object: &'static Object, secret: bool) -> String {
+    let a = &object.access;
+    let mut h = String::new();
+    for (on, action, label) in [
+        (a.read, "read", "Read"),
+        (a.write, "write", "Write"),
+        (a.write, "default", "Factory default"),
+        (a.erase, "erase", "Erase"),
+    ] {
+        if on {
+            h.push_str(&format!(
+                "<button data-action=\"{action}\">{label}</button>"
+            ));
+        }
+    }
+    if secret {
+        h.push_str("<label class=\"reveal\"><input type=\"checkbox\" data-action=\"reveal\"> Reveal key</label>");
+    }
+    h
+}
+
+/// The `data-action` of what a click was on (a button, the Reveal box).
+fn action_of(ev: &web_sys::MouseEvent) -> String {
+    use wasm_bindgen::JsCast;
+    ev.target()
+        .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+        .and_then(|e| e.closest("[data-action]").ok().flatten())
+        .and_then(|e| e.get_attribute("data-action"))
+        .unwrap_or_default()
 }
 
 /// What is typed into a field's input (found by its `name`), into
