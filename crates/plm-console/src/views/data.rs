@@ -4,7 +4,7 @@
 //! indications) as plm-core decoded them in the traffic log.
 
 use super::snr_plot::{self, Point};
-use super::widgets::{on_event, text_table};
+use super::widgets::{set_checked, set_value, signal, text_input, text_table};
 use super::{millis, seconds, spaced};
 use crate::app::Tab;
 use crate::session::Outcome;
@@ -158,23 +158,36 @@ fn build(f: &Form, dl_crc_len: usize) -> Result<Command, String> {
 #[component]
 fn DataRequestCard() -> impl IntoView {
     let c = use_console();
-    let form = crate::views::widgets::signal(Form {
-        layer: "dl".into(),
-        modulation: "0".into(),
-        frequency: "high".into(),
-        custom_hz: "86000".into(),
-        overwrite: false,
-        gain: String::new(),
-        zc: false,
-        header_length: "4".into(),
-        text: true,
-        payload: "hello street".into(),
-    });
+    // The form's inputs, each a signal of a type the page has anyway,
+    // made a [`Form`] when sent.
+    let text = |t: &str| signal(t.to_string());
+    let layer = text("dl");
+    let modulation = text("0");
+    let frequency = text("high");
+    let custom_hz = text("86000");
+    let overwrite = signal(false);
+    let gain = text("");
+    let zc = signal(false);
+    let header_length = text("4");
+    let kind = text("text");
+    let payload = text("hello street");
+    let form = move || Form {
+        layer: layer.get_untracked(),
+        modulation: modulation.get_untracked(),
+        frequency: frequency.get_untracked(),
+        custom_hz: custom_hz.get_untracked(),
+        overwrite: overwrite.get_untracked(),
+        gain: gain.get_untracked(),
+        zc: zc.get_untracked(),
+        header_length: header_length.get_untracked(),
+        text: kind.get_untracked() == "text",
+        payload: payload.get_untracked(),
+    };
     // What came of it, and whether that is a problem: two signals of types
     // the page has anyway rather than one `Option<Result<String, String>>`
     // (each signal type brings its own code, docs/console.md "Size").
-    let result = crate::views::widgets::signal(None::<String>);
-    let problem = crate::views::widgets::signal(false);
+    let result = signal(None::<String>);
+    let problem = signal(false);
     let show = move |r: Result<String, String>| {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));
@@ -193,7 +206,7 @@ fn DataRequestCard() -> impl IntoView {
         [1, 2, 4, 4][ModemConfig::decode(&data).crc_length as usize & 3]
     };
     let send = move || {
-        let cmd = match build(&form.get_untracked(), dl_crc_len()) {
+        let cmd = match build(&form(), dl_crc_len()) {
             Ok(cmd) => cmd,
             Err(why) => {
                 show(Err(format!("nothing sent: {why}")));
@@ -229,9 +242,14 @@ fn DataRequestCard() -> impl IntoView {
             })
         });
     };
-    let set = move |f: fn(&mut Form, String)| {
-        move |ev: leptos::ev::Event| form.update(|x| f(x, event_target_value(&ev)))
-    };
+    let not_custom = move || frequency.get() != "custom";
+    // The modulations but the reserved codes, as the select's options.
+    let modulations: String = MODULATIONS
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n != "Reserved")
+        .map(|(i, n)| format!("<option value=\"{i}\">{n}</option>"))
+        .collect();
     view! {
         <article class="card wide" id="data-request">
             <h3>"Send a frame"</h3>
@@ -241,7 +259,7 @@ fn DataRequestCard() -> impl IntoView {
             <div class="form-row">
                 <label>
                     "Layer "
-                    <select id="data-layer" on:change=on_event(set(|f, v| f.layer = v))>
+                    <select id="data-layer" on:change=set_value(layer)>
                         <option value="phy">"PHY"</option>
                         <option value="dl" selected>"DL"</option>
                         <option value="ss">"SS"</option>
@@ -249,86 +267,50 @@ fn DataRequestCard() -> impl IntoView {
                 </label>
                 <label>
                     "Modulation "
-                    <select id="data-modulation" on:change=on_event(set(|f, v| f.modulation = v))>
-                        {MODULATIONS
-                            .iter()
-                            .enumerate()
-                            .filter(|(_, n)| **n != "Reserved")
-                            .map(|(i, n)| view! { <option value=i.to_string()>{*n}</option> })
-                            .map(IntoAny::into_any).collect_view()}
-                    </select>
+                    <select
+                        id="data-modulation"
+                        inner_html=modulations
+                        on:change=set_value(modulation)
+                    ></select>
                 </label>
                 <label>
                     "Frequency "
-                    <select id="data-frequency" on:change=on_event(set(|f, v| f.frequency = v))>
+                    <select id="data-frequency" on:change=set_value(frequency)>
                         <option value="high" selected>"MIB high frequency"</option>
                         <option value="low">"MIB low frequency"</option>
                         <option value="custom">"custom"</option>
                     </select>
                 </label>
-                <label hidden=move || form.with(|f| f.frequency != "custom")>
+                <label hidden=not_custom>
                     "Hz "
-                    <input
-                        id="data-custom-hz"
-                        size="7"
-                        prop:value=move || form.with(|f| f.custom_hz.clone())
-                        on:input=on_event(set(|f, v| f.custom_hz = v))
-                    />
+                    {text_input("data-custom-hz", "", "", Some(7), custom_hz)}
                 </label>
-                <label hidden=move || form.with(|f| f.frequency != "custom")>
-                    <input
-                        type="checkbox"
-                        id="data-overwrite"
-                        on:change=on_event(move |ev| form.update(|f| f.overwrite = event_target_checked(&ev)))
-                    />
+                <label hidden=not_custom>
+                    <input type="checkbox" id="data-overwrite" on:change=set_checked(overwrite)/>
                     " overwrite MIB frequency"
                 </label>
                 <label title="Empty: the MIB's TX gain">
                     "TX gain "
-                    <input
-                        id="data-gain"
-                        size="3"
-                        placeholder="MIB"
-                        prop:value=move || form.with(|f| f.gain.clone())
-                        on:input=on_event(set(|f, v| f.gain = v))
-                    />
+                    {text_input("data-gain", "", "MIB", Some(3), gain)}
                 </label>
                 <label>
-                    <input
-                        type="checkbox"
-                        id="data-zc"
-                        on:change=on_event(move |ev| form.update(|f| f.zc = event_target_checked(&ev)))
-                    />
+                    <input type="checkbox" id="data-zc" on:change=set_checked(zc)/>
                     " zero-crossing synchronisation"
                 </label>
-                <label hidden=move || form.with(|f| f.layer != "ss")>
+                <label hidden=move || layer.get() != "ss">
                     "SS header length "
-                    <input
-                        id="data-header-length"
-                        size="3"
-                        prop:value=move || form.with(|f| f.header_length.clone())
-                        on:input=on_event(set(|f, v| f.header_length = v))
-                    />
+                    {text_input("data-header-length", "", "", Some(3), header_length)}
                 </label>
             </div>
             <div class="form-row">
                 <label>
                     "Payload as "
-                    <select
-                        id="data-payload-kind"
-                        on:change=on_event(move |ev| form.update(|f| f.text = event_target_value(&ev) == "text"))
-                    >
+                    <select id="data-payload-kind" on:change=set_value(kind)>
                         <option value="text" selected>"text"</option>
                         <option value="hex">"hex"</option>
                     </select>
                 </label>
-                <input
-                    id="data-payload"
-                    class="payload"
-                    size="60"
-                    prop:value=move || form.with(|f| f.payload.clone())
-                    on:input=on_event(set(|f, v| f.payload = v))
-                />
+                {text_input("data-payload", "payload", "", Some(60), payload)}
                 {super::widgets::button("data-send", "Send", "", send)}
             </div>
             <p id="data-result" class:problem=move || problem.get()>
