@@ -8,7 +8,7 @@
 
 use super::files;
 use super::widgets::{button, escape, on_click, on_event};
-use crate::mibform::{self, Problems};
+use crate::mibform;
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::field::Kind;
@@ -222,7 +222,9 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
             }
         }
     });
-    let problems = crate::views::widgets::signal(Problems::default());
+    // Why the form was refused, by field name; the object's own reason
+    // under "" (a signal of the inputs' type: no signal type of its own).
+    let problems = crate::views::widgets::signal(Inputs::default());
     let reveal = crate::views::widgets::signal(false);
     let base = move || {
         read_value
@@ -248,11 +250,15 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                     Some(why) => format!("nothing sent: {why}"),
                     None => format!("nothing sent: {n} field(s) need fixing (see the reasons)"),
                 });
-                problems.set(p);
+                let mut why = p.fields;
+                if let Some(o) = p.object {
+                    why.insert("", o);
+                }
+                problems.set(why);
                 return;
             }
         };
-        problems.set(Problems::default());
+        problems.set(Inputs::default());
         status.set("writing…".into());
         let sent = data.clone();
         c.write_mib(idx, mibform::write_data(object, &data), move |r| match r {
@@ -289,7 +295,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
     };
     let load_default = move || {
         inputs.set(inputs_of(object, object.default));
-        problems.set(Problems::default());
+        problems.set(Inputs::default());
         status.set("factory default loaded into the form: Write to send it".into());
     };
     view! {
@@ -399,7 +405,7 @@ fn typed(object: &'static Object, inputs: RwSignal<Inputs>, ev: &web_sys::Event)
 fn card_html(
     object: &'static Object,
     status: &str,
-    problems: &Problems,
+    problems: &Inputs,
     read: Option<&[u8]>,
     inputs: &Inputs,
     masked: bool,
@@ -414,7 +420,7 @@ fn card_html(
     };
     let current = read.unwrap_or(object.default);
     let mut h = format!("<p class=\"status\" data-role=\"status\">{}</p>", escape(status));
-    if let Some(o) = &problems.object {
+    if let Some(o) = problems.get("") {
         let _ = write!(h, "<p class=\"problem\">{}</p>", escape(o));
     }
     h.push_str("<table class=\"fields\"><thead><tr><th>Field</th><th>Value</th><th>Allowed</th><th>Factory default</th><th></th></tr></thead><tbody>");
@@ -424,7 +430,7 @@ fn card_html(
         // Reserved and unused bits are shown only when they are not zero.
         let visible = field.settable || field.get(current).is_some_and(|v| v != 0);
         let differs = read.is_some_and(|v| field.read(v) != field.read(object.default));
-        let invalid = problems.fields.get(name);
+        let invalid = problems.get(name);
         let _ = write!(
             h,
             "<tr data-field=\"{name}\" class=\"{}{}\"{}><th>{}{}</th><td>",
