@@ -12,6 +12,7 @@ use crate::mibform;
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::field::Kind;
+use plm_core::link::Dialect;
 use plm_core::mib::Object;
 use plm_core::st7580::mib::index;
 use std::rc::Rc;
@@ -29,11 +30,9 @@ fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
 pub fn ModemView() -> impl IntoView {
     let c = use_console();
     let progress = crate::views::widgets::signal(None::<String>);
-    // The chip's objects, redrawn when the chip changes.
-    let objects = Memo::new(move |_| {
-        let dialect = c.profile.get().dialect();
-        (plm_core::chip::for_dialect(dialect).mib(), dialect)
-    });
+    // The chip (ST7570 or not), its objects redrawn when it changes: a
+    // memo of a type the page has anyway.
+    let st7570 = Memo::new(move |_| c.profile.get().dialect() == Dialect::St7570);
     let read_all = move || {
         // What the modem has as configured now (an ST7570 in PHY mode
         // has no MAC objects).
@@ -74,20 +73,21 @@ pub fn ModemView() -> impl IntoView {
             <span class="muted" id="mib-progress">{move || progress.get()}</span>
             <Profiles/>
             <span class="muted">
-                {move || String::from(match objects.get().1 {
-                    plm_core::link::Dialect::St7580 => "ST7580 MIB (UM0932 4, Table 52).",
-                    plm_core::link::Dialect::St7570 => "ST7570 MIB (ST7570 UM 6, Table 71).",
+                {move || String::from(if st7570.get() {
+                    "ST7570 MIB (ST7570 UM 6, Table 71)."
+                } else {
+                    "ST7580 MIB (UM0932 4, Table 52)."
                 })}
                 " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>
-        <div class="cards" hidden=move || objects.get().1 != plm_core::link::Dialect::St7570>
+        <div class="cards" hidden=move || !st7570.get()>
             <super::sfsk_setup::SetupCard/>
         </div>
         <div class="mib-list">
             {move || {
-                let (list, dialect) = objects.get();
-                list.iter()
+                let dialect = if st7570.get() { Dialect::St7570 } else { Dialect::St7580 };
+                plm_core::chip::for_dialect(dialect).mib().iter()
                     .map(|o| view! { <MibCard object=o dialect=dialect/> })
                     .map(IntoAny::into_any)
                     .collect_view()
@@ -204,10 +204,10 @@ fn apply_profile(
 
 /// One MIB object: its fields, read, write, erase and factory default.
 #[component]
-fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl IntoView {
+fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
     let c = use_console();
     let idx = object.index;
-    let secret = dialect == plm_core::link::Dialect::St7580 && idx == index::SS_KEY as u16;
+    let secret = dialect == Dialect::St7580 && idx == index::SS_KEY as u16;
     let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
     let inputs = crate::views::widgets::signal(inputs_of(object, object.default));
     const NOT_READ: &str = "not read yet: the form shows the factory default";
@@ -337,7 +337,7 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
 }
 
 /// A card's heading: index, name, access and where the manual has it.
-fn header_html(object: &'static Object, dialect: plm_core::link::Dialect) -> String {
+fn header_html(object: &'static Object, dialect: Dialect) -> String {
     format!(
         "<h3><span class=\"index\">{}h</span> {}</h3><span class=\"access\" title=\"Access\">{}</span><span class=\"muted\">{}</span>",
         mibform::index_text(dialect, object.index),
