@@ -208,28 +208,36 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
     let c = use_console();
     let idx = object.index;
     let secret = dialect == Dialect::St7580 && idx == index::SS_KEY as u16;
-    let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
+    // The value last read, untracked: the effect below redraws the form
+    // (through `inputs`) when it changes (no memo type of its own).
+    let read_value = move || c.modem.mib.with_untracked(|m| m.get(&idx).cloned());
     let inputs = crate::views::widgets::signal(inputs_of(object, object.default));
     const NOT_READ: &str = "not read yet: the form shows the factory default";
     let status = crate::views::widgets::signal(String::from(NOT_READ));
-    Effect::new(move |_| {
-        if let Some(v) = read_value.get() {
-            inputs.set(inputs_of(object, &v));
-            // Read elsewhere (Read all, a profile, the set-up card): say so
-            // instead of "not read yet".
-            if status.with_untracked(|s| s == NOT_READ) {
-                status.set("read from the modem".into());
+    Effect::new(move |last: Option<Option<Vec<u8>>>| {
+        let value = c.modem.mib.with(|m| m.get(&idx).cloned());
+        if last.as_ref() != Some(&value) {
+            match &value {
+                Some(v) => {
+                    inputs.set(inputs_of(object, v));
+                    // Read elsewhere (Read all, a profile, the set-up
+                    // card): say so instead of "not read yet".
+                    if status.with_untracked(|s| s == NOT_READ) {
+                        status.set("read from the modem".into());
+                    }
+                }
+                // Forgotten (a new connection): the form redrawn as such.
+                None => inputs.update(|_| {}),
             }
         }
+        value
     });
     // Why the form was refused, by field name; the object's own reason
     // under "" (a signal of the inputs' type: no signal type of its own).
     let problems = crate::views::widgets::signal(Inputs::default());
     let reveal = crate::views::widgets::signal(false);
     let base = move || {
-        read_value
-            .get_untracked()
-            .unwrap_or_else(|| object.default.to_vec())
+        read_value().unwrap_or_else(|| object.default.to_vec())
     };
 
     let read = move || {
@@ -325,7 +333,7 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
                         object,
                         &status.get(),
                         &problems.get(),
-                        read_value.get().as_deref(),
+                        read_value().as_deref(),
                         &inputs.get(),
                         secret && !reveal.get(),
                     )
