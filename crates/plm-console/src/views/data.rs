@@ -11,6 +11,7 @@ use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;
 use leptos::prelude::*;
+use std::sync::Arc;
 use plm_core::json::Json;
 use plm_core::st7580::fields::{confirm_data, tx_options, MODULATIONS};
 use plm_core::st7580::mib::{index, ModemConfig};
@@ -60,7 +61,7 @@ fn payload(e: &Entry) -> String {
 /// The SNR of each indication, in log order. Left out: B-FSK frames (SNR
 /// byte 255, "no meaning", decoded as null: UM0932 Table 39) and entries
 /// imported without a time.
-fn snr_points(rows: &[std::sync::Arc<Entry>]) -> Vec<Point> {
+fn snr_points(rows: &[Arc<Entry>]) -> Vec<Point> {
     rows.iter()
         .filter_map(|e| Point::new(e.at?, field(e, "snr").parse().ok()?, &e.title()))
         .collect()
@@ -338,26 +339,41 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
     // Hidden, the plot keeps its points and does not look at the log (as
     // the Traffic table).
     let shown = move || tab.get() == Tab::Data;
-    let rows = Memo::new(move |prev: Option<&Vec<std::sync::Arc<Entry>>>| {
-        if let Some(p) = prev.filter(|_| !shown()) {
-            return p.clone();
-        }
-        let mut rows = c.traffic.log.with(|l| {
-            l.iter()
-                .filter(|e| {
-                    e.decoded
-                        .command
-                        .as_ref()
-                        .and_then(|c| c.as_str())
-                        .is_some_and(|c| INDICATIONS.contains(&c))
-                })
-                .cloned()
-                .collect::<Vec<_>>()
-        });
-        let older = rows.len().saturating_sub(INDICATION_ROWS);
-        rows.drain(..older);
-        rows
-    });
+    // The indications (how many, the newest INDICATION_ROWS), compared
+    // by what they are (as the Traffic table's rows, and of their type: one
+    // memo type for both).
+    let rows = Memo::new_with_compare(
+        move |prev: Option<&(usize, Vec<Arc<Entry>>)>| {
+            if let Some(p) = prev.filter(|_| !shown()) {
+                return p.clone();
+            }
+            let mut rows = c.traffic.log.with(|l| {
+                l.iter()
+                    .filter(|e| {
+                        e.decoded
+                            .command
+                            .as_ref()
+                            .and_then(|c| c.as_str())
+                            .is_some_and(|c| INDICATIONS.contains(&c))
+                    })
+                    .cloned()
+                    .collect::<Vec<_>>()
+            });
+            let total = rows.len();
+            rows.drain(..total.saturating_sub(INDICATION_ROWS));
+            (total, rows)
+        },
+        |old: Option<&(usize, Vec<Arc<Entry>>)>, new: Option<&(usize, Vec<Arc<Entry>>)>| match (
+            old, new,
+        ) {
+            (Some(a), Some(b)) => {
+                a.0 != b.0
+                    || a.1.len() != b.1.len()
+                    || a.1.iter().zip(&b.1).any(|(x, y)| !Arc::ptr_eq(x, y))
+            }
+            _ => true,
+        },
+    );
     view! {
         <article class="card wide" id="data-indications">
             <h3>"Received frames"</h3>
@@ -366,7 +382,7 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
             </p>
             // The plot, or why there is none, written as HTML in one go.
             <div inner_html=move || {
-                rows.with(|r| match snr_plot::layout(&snr_points(r)) {
+                rows.with(|(_, r)| match snr_plot::layout(&snr_points(r)) {
                     Some(plot) => snr_plot::draw(&plot),
                     None if r.is_empty() => {
                         "<p class=\"muted\" id=\"snr-plot-empty\">No indications yet: send a frame with echoing peers (Simulator view).</p>".to_string()
@@ -379,6 +395,7 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
             // At most INDICATION_ROWS rows, rewritten when one arrives.
             {text_table("indications-table", INDICATION_COLUMNS, Box::new(move || {
                 rows.get()
+                    .1
                     .iter()
                     .map(|e| {
                         vec![
