@@ -11,13 +11,13 @@ use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;
 use leptos::prelude::*;
-use std::sync::Arc;
 use plm_core::json::Json;
 use plm_core::st7580::fields::{confirm_data, tx_options, MODULATIONS};
 use plm_core::st7580::mib::{index, ModemConfig};
 use plm_core::st7580::{
     validate, Command, DataRequest, FrequencySet, Modulation, SsDataRequest, TxParams,
 };
+use std::sync::Arc;
 
 /// Received frames shown, the most recent (the traffic log keeps them all).
 const INDICATION_ROWS: usize = 200;

@@ -349,15 +349,36 @@ pub fn draw(plot: &Plot) -> String {
     };
     for t in &plot.y_ticks {
         line(&mut h, "snr-grid", LEFT, RIGHT, t.at, t.at);
-        text(&mut h, "snr-tick snr-y-tick", LEFT - 6.0, t.at, "", &t.label);
+        text(
+            &mut h,
+            "snr-tick snr-y-tick",
+            LEFT - 6.0,
+            t.at,
+            "",
+            &t.label,
+        );
     }
     for t in &plot.x_ticks {
         line(&mut h, "snr-axis", t.at, t.at, BOTTOM, BOTTOM + 4.0);
-        text(&mut h, "snr-tick snr-x-tick", t.at, BOTTOM + 17.0, "", &t.label);
+        text(
+            &mut h,
+            "snr-tick snr-x-tick",
+            t.at,
+            BOTTOM + 17.0,
+            "",
+            &t.label,
+        );
     }
     line(&mut h, "snr-axis", LEFT, LEFT, TOP, BOTTOM);
     line(&mut h, "snr-axis", LEFT, RIGHT, BOTTOM, BOTTOM);
-    text(&mut h, "snr-title", (LEFT + RIGHT) / 2.0, HEIGHT - 6.0, "", "time (s)");
+    text(
+        &mut h,
+        "snr-title",
+        (LEFT + RIGHT) / 2.0,
+        HEIGHT - 6.0,
+        "",
+        "time (s)",
+    );
     let rotate = format!(" transform=\"rotate(-90 16 {})\"", n(middle));
     text(&mut h, "snr-title", 16.0, middle, &rotate, "SNR (dB)");
     let circle = |h: &mut String, class: &str, kind: Kind, cx: f64, cy: f64, title: &str| {
@@ -372,7 +393,14 @@ pub fn draw(plot: &Plot) -> String {
     };
     for &(kind, x) in &plot.legend {
         circle(&mut h, "snr-key", kind, x + RADIUS, TOP - 14.0, "");
-        text(&mut h, "snr-legend", x + 2.0 * RADIUS + 5.0, TOP - 14.0, "", kind.label());
+        text(
+            &mut h,
+            "snr-legend",
+            x + 2.0 * RADIUS + 5.0,
+            TOP - 14.0,
+            "",
+            kind.label(),
+        );
     }
     text(&mut h, "snr-count", RIGHT, TOP - 14.0, "", &plot.count);
     for m in &plot.markers {
