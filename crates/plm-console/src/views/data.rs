@@ -4,7 +4,7 @@
 //! indications) as plm-core decoded them in the traffic log.
 
 use super::snr_plot::{self, Point};
-use super::widgets::{on_event, text_table};
+use super::widgets::{set_checked, set_value, signal, text_input, text_table};
 use super::{millis, seconds, spaced};
 use crate::app::Tab;
 use crate::session::Outcome;
@@ -17,6 +17,7 @@ use plm_core::st7580::mib::{index, ModemConfig};
 use plm_core::st7580::{
     validate, Command, DataRequest, FrequencySet, Modulation, SsDataRequest, TxParams,
 };
+use std::sync::Arc;
 
 /// Received frames shown, the most recent (the traffic log keeps them all).
 const INDICATION_ROWS: usize = 200;
@@ -60,7 +61,7 @@ fn payload(e: &Entry) -> String {
 /// The SNR of each indication, in log order. Left out: B-FSK frames (SNR
 /// byte 255, "no meaning", decoded as null: UM0932 Table 39) and entries
 /// imported without a time.
-fn snr_points(rows: &[std::sync::Arc<Entry>]) -> Vec<Point> {
+fn snr_points(rows: &[Arc<Entry>]) -> Vec<Point> {
     rows.iter()
         .filter_map(|e| Point::new(e.at?, field(e, "snr").parse().ok()?, &e.title()))
         .collect()
@@ -158,23 +159,36 @@ fn build(f: &Form, dl_crc_len: usize) -> Result<Command, String> {
 #[component]
 fn DataRequestCard() -> impl IntoView {
     let c = use_console();
-    let form = crate::views::widgets::signal(Form {
-        layer: "dl".into(),
-        modulation: "0".into(),
-        frequency: "high".into(),
-        custom_hz: "86000".into(),
-        overwrite: false,
-        gain: String::new(),
-        zc: false,
-        header_length: "4".into(),
-        text: true,
-        payload: "hello street".into(),
-    });
+    // The form's inputs, each a signal of a type the page has anyway,
+    // made a [`Form`] when sent.
+    let text = |t: &str| signal(t.to_string());
+    let layer = text("dl");
+    let modulation = text("0");
+    let frequency = text("high");
+    let custom_hz = text("86000");
+    let overwrite = signal(false);
+    let gain = text("");
+    let zc = signal(false);
+    let header_length = text("4");
+    let kind = text("text");
+    let payload = text("hello street");
+    let form = move || Form {
+        layer: layer.get_untracked(),
+        modulation: modulation.get_untracked(),
+        frequency: frequency.get_untracked(),
+        custom_hz: custom_hz.get_untracked(),
+        overwrite: overwrite.get_untracked(),
+        gain: gain.get_untracked(),
+        zc: zc.get_untracked(),
+        header_length: header_length.get_untracked(),
+        text: kind.get_untracked() == "text",
+        payload: payload.get_untracked(),
+    };
     // What came of it, and whether that is a problem: two signals of types
     // the page has anyway rather than one `Option<Result<String, String>>`
     // (each signal type brings its own code, docs/console.md "Size").
-    let result = crate::views::widgets::signal(None::<String>);
-    let problem = crate::views::widgets::signal(false);
+    let result = signal(None::<String>);
+    let problem = signal(false);
     let show = move |r: Result<String, String>| {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));
@@ -193,7 +207,7 @@ fn DataRequestCard() -> impl IntoView {
         [1, 2, 4, 4][ModemConfig::decode(&data).crc_length as usize & 3]
     };
     let send = move || {
-        let cmd = match build(&form.get_untracked(), dl_crc_len()) {
+        let cmd = match build(&form(), dl_crc_len()) {
             Ok(cmd) => cmd,
             Err(why) => {
                 show(Err(format!("nothing sent: {why}")));
@@ -229,9 +243,14 @@ fn DataRequestCard() -> impl IntoView {
             })
         });
     };
-    let set = move |f: fn(&mut Form, String)| {
-        move |ev: leptos::ev::Event| form.update(|x| f(x, event_target_value(&ev)))
-    };
+    let not_custom = move || frequency.get() != "custom";
+    // The modulations but the reserved codes, as the select's options.
+    let modulations: String = MODULATIONS
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n != "Reserved")
+        .map(|(i, n)| format!("<option value=\"{i}\">{n}</option>"))
+        .collect();
     view! {
         <article class="card wide" id="data-request">
             <h3>"Send a frame"</h3>
@@ -241,7 +260,7 @@ fn DataRequestCard() -> impl IntoView {
             <div class="form-row">
                 <label>
                     "Layer "
-                    <select id="data-layer" on:change=on_event(set(|f, v| f.layer = v))>
+                    <select id="data-layer" on:change=set_value(layer)>
                         <option value="phy">"PHY"</option>
                         <option value="dl" selected>"DL"</option>
                         <option value="ss">"SS"</option>
@@ -249,86 +268,50 @@ fn DataRequestCard() -> impl IntoView {
                 </label>
                 <label>
                     "Modulation "
-                    <select id="data-modulation" on:change=on_event(set(|f, v| f.modulation = v))>
-                        {MODULATIONS
-                            .iter()
-                            .enumerate()
-                            .filter(|(_, n)| **n != "Reserved")
-                            .map(|(i, n)| view! { <option value=i.to_string()>{*n}</option> })
-                            .map(IntoAny::into_any).collect_view()}
-                    </select>
+                    <select
+                        id="data-modulation"
+                        inner_html=modulations
+                        on:change=set_value(modulation)
+                    ></select>
                 </label>
                 <label>
                     "Frequency "
-                    <select id="data-frequency" on:change=on_event(set(|f, v| f.frequency = v))>
+                    <select id="data-frequency" on:change=set_value(frequency)>
                         <option value="high" selected>"MIB high frequency"</option>
                         <option value="low">"MIB low frequency"</option>
                         <option value="custom">"custom"</option>
                     </select>
                 </label>
-                <label hidden=move || form.with(|f| f.frequency != "custom")>
+                <label hidden=not_custom>
                     "Hz "
-                    <input
-                        id="data-custom-hz"
-                        size="7"
-                        prop:value=move || form.with(|f| f.custom_hz.clone())
-                        on:input=on_event(set(|f, v| f.custom_hz = v))
-                    />
+                    {text_input("data-custom-hz", "", "", Some(7), custom_hz)}
                 </label>
-                <label hidden=move || form.with(|f| f.frequency != "custom")>
-                    <input
-                        type="checkbox"
-                        id="data-overwrite"
-                        on:change=on_event(move |ev| form.update(|f| f.overwrite = event_target_checked(&ev)))
-                    />
+                <label hidden=not_custom>
+                    <input type="checkbox" id="data-overwrite" on:change=set_checked(overwrite)/>
                     " overwrite MIB frequency"
                 </label>
                 <label title="Empty: the MIB's TX gain">
                     "TX gain "
-                    <input
-                        id="data-gain"
-                        size="3"
-                        placeholder="MIB"
-                        prop:value=move || form.with(|f| f.gain.clone())
-                        on:input=on_event(set(|f, v| f.gain = v))
-                    />
+                    {text_input("data-gain", "", "MIB", Some(3), gain)}
                 </label>
                 <label>
-                    <input
-                        type="checkbox"
-                        id="data-zc"
-                        on:change=on_event(move |ev| form.update(|f| f.zc = event_target_checked(&ev)))
-                    />
+                    <input type="checkbox" id="data-zc" on:change=set_checked(zc)/>
                     " zero-crossing synchronisation"
                 </label>
-                <label hidden=move || form.with(|f| f.layer != "ss")>
+                <label hidden=move || layer.get() != "ss">
                     "SS header length "
-                    <input
-                        id="data-header-length"
-                        size="3"
-                        prop:value=move || form.with(|f| f.header_length.clone())
-                        on:input=on_event(set(|f, v| f.header_length = v))
-                    />
+                    {text_input("data-header-length", "", "", Some(3), header_length)}
                 </label>
             </div>
             <div class="form-row">
                 <label>
                     "Payload as "
-                    <select
-                        id="data-payload-kind"
-                        on:change=on_event(move |ev| form.update(|f| f.text = event_target_value(&ev) == "text"))
-                    >
+                    <select id="data-payload-kind" on:change=set_value(kind)>
                         <option value="text" selected>"text"</option>
                         <option value="hex">"hex"</option>
                     </select>
                 </label>
-                <input
-                    id="data-payload"
-                    class="payload"
-                    size="60"
-                    prop:value=move || form.with(|f| f.payload.clone())
-                    on:input=on_event(set(|f, v| f.payload = v))
-                />
+                {text_input("data-payload", "payload", "", Some(60), payload)}
                 {super::widgets::button("data-send", "Send", "", send)}
             </div>
             <p id="data-result" class:problem=move || problem.get()>
@@ -356,56 +339,63 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
     // Hidden, the plot keeps its points and does not look at the log (as
     // the Traffic table).
     let shown = move || tab.get() == Tab::Data;
-    let rows = Memo::new(move |prev: Option<&Vec<std::sync::Arc<Entry>>>| {
-        if let Some(p) = prev.filter(|_| !shown()) {
-            return p.clone();
-        }
-        let mut rows = c.traffic.log.with(|l| {
-            l.iter()
-                .filter(|e| {
-                    e.decoded
-                        .command
-                        .as_ref()
-                        .and_then(|c| c.as_str())
-                        .is_some_and(|c| INDICATIONS.contains(&c))
-                })
-                .cloned()
-                .collect::<Vec<_>>()
-        });
-        let older = rows.len().saturating_sub(INDICATION_ROWS);
-        rows.drain(..older);
-        rows
-    });
+    // The indications (how many, the newest INDICATION_ROWS), compared
+    // by what they are (as the Traffic table's rows, and of their type: one
+    // memo type for both).
+    let rows = Memo::new_with_compare(
+        move |prev: Option<&(usize, Vec<Arc<Entry>>)>| {
+            if let Some(p) = prev.filter(|_| !shown()) {
+                return p.clone();
+            }
+            let mut rows = c.traffic.log.with(|l| {
+                l.iter()
+                    .filter(|e| {
+                        e.decoded
+                            .command
+                            .as_ref()
+                            .and_then(|c| c.as_str())
+                            .is_some_and(|c| INDICATIONS.contains(&c))
+                    })
+                    .cloned()
+                    .collect::<Vec<_>>()
+            });
+            let total = rows.len();
+            rows.drain(..total.saturating_sub(INDICATION_ROWS));
+            (total, rows)
+        },
+        |old: Option<&(usize, Vec<Arc<Entry>>)>, new: Option<&(usize, Vec<Arc<Entry>>)>| match (
+            old, new,
+        ) {
+            (Some(a), Some(b)) => {
+                a.0 != b.0
+                    || a.1.len() != b.1.len()
+                    || a.1.iter().zip(&b.1).any(|(x, y)| !Arc::ptr_eq(x, y))
+            }
+            _ => true,
+        },
+    );
     view! {
         <article class="card wide" id="data-indications">
             <h3>"Received frames"</h3>
             <p class="muted">
                 "Data and sniffer indications from the modem (UM0932 Table 39). With echoing peers (Simulator view) every frame sent comes back."
             </p>
-            {move || {
-                rows.with(|r| match snr_plot::layout(&snr_points(r)) {
-                    Some(plot) => snr_plot::draw(plot).into_any(),
+            // The plot, or why there is none, written as HTML in one go.
+            <div inner_html=move || {
+                rows.with(|(_, r)| match snr_plot::layout(&snr_points(r)) {
+                    Some(plot) => snr_plot::draw(&plot),
                     None if r.is_empty() => {
-                        view! {
-                            <p class="muted" id="snr-plot-empty">
-                                "No indications yet: send a frame with echoing peers (Simulator view)."
-                            </p>
-                        }
-                            .into_any()
+                        "<p class=\"muted\" id=\"snr-plot-empty\">No indications yet: send a frame with echoing peers (Simulator view).</p>".to_string()
                     }
                     None => {
-                        view! {
-                            <p class="muted" id="snr-plot-empty">
-                                "No SNR to plot: B-FSK frames carry none, and imported entries may have no time."
-                            </p>
-                        }
-                            .into_any()
+                        "<p class=\"muted\" id=\"snr-plot-empty\">No SNR to plot: B-FSK frames carry none, and imported entries may have no time.</p>".to_string()
                     }
                 })
-            }}
+            }></div>
             // At most INDICATION_ROWS rows, rewritten when one arrives.
             {text_table("indications-table", INDICATION_COLUMNS, Box::new(move || {
                 rows.get()
+                    .1
                     .iter()
                     .map(|e| {
                         vec![

@@ -7,11 +7,12 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
-use super::widgets::{action_button, button, on_event};
-use crate::mibform::{self, Problems};
+use super::widgets::{button, escape, on_click, on_event};
+use crate::mibform;
 use crate::stores::use_console;
 use leptos::prelude::*;
-use plm_core::field::{Field, Kind};
+use plm_core::field::Kind;
+use plm_core::link::Dialect;
 use plm_core::mib::Object;
 use plm_core::st7580::mib::index;
 use std::rc::Rc;
@@ -29,11 +30,9 @@ fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
 pub fn ModemView() -> impl IntoView {
     let c = use_console();
     let progress = crate::views::widgets::signal(None::<String>);
-    // The chip's objects, redrawn when the chip changes.
-    let objects = Memo::new(move |_| {
-        let dialect = c.profile.get().dialect();
-        (plm_core::chip::for_dialect(dialect).mib(), dialect)
-    });
+    // The chip (ST7570 or not), its objects redrawn when it changes: a
+    // memo of a type the page has anyway.
+    let st7570 = Memo::new(move |_| c.profile.get().dialect() == Dialect::St7570);
     let read_all = move || {
         // What the modem has as configured now (an ST7570 in PHY mode
         // has no MAC objects).
@@ -49,23 +48,26 @@ pub fn ModemView() -> impl IntoView {
         let failed = crate::views::widgets::signal(0usize);
         progress.set(Some(format!("Reading 0 of {total}…")));
         for i in readable {
-            c.read_mib(i, move |r| {
-                if r.is_err() {
-                    failed.update(|f| *f += 1);
-                }
-                done.update(|d| *d += 1);
-                let (d, f) = (done.get_untracked(), failed.get_untracked());
-                progress.set(Some(if d < total {
-                    format!("Reading {d} of {total}…")
-                } else if f == 0 {
-                    format!("Read all {total} objects.")
-                } else {
-                    format!(
-                        "Read {} of {total} objects; {f} failed (see each object).",
-                        d - f
-                    )
-                }));
-            });
+            c.read_mib(
+                i,
+                mib_done(move |r| {
+                    if r.is_err() {
+                        failed.update(|f| *f += 1);
+                    }
+                    done.update(|d| *d += 1);
+                    let (d, f) = (done.get_untracked(), failed.get_untracked());
+                    progress.set(Some(if d < total {
+                        format!("Reading {d} of {total}…")
+                    } else if f == 0 {
+                        format!("Read all {total} objects.")
+                    } else {
+                        format!(
+                            "Read {} of {total} objects; {f} failed (see each object).",
+                            d - f
+                        )
+                    }));
+                }),
+            );
         }
     };
     view! {
@@ -74,20 +76,21 @@ pub fn ModemView() -> impl IntoView {
             <span class="muted" id="mib-progress">{move || progress.get()}</span>
             <Profiles/>
             <span class="muted">
-                {move || String::from(match objects.get().1 {
-                    plm_core::link::Dialect::St7580 => "ST7580 MIB (UM0932 4, Table 52).",
-                    plm_core::link::Dialect::St7570 => "ST7570 MIB (ST7570 UM 6, Table 71).",
+                {move || String::from(if st7570.get() {
+                    "ST7570 MIB (ST7570 UM 6, Table 71)."
+                } else {
+                    "ST7580 MIB (UM0932 4, Table 52)."
                 })}
                 " Values are checked as the modem checks them before anything is sent."
             </span>
         </div>
-        <div class="cards" hidden=move || objects.get().1 != plm_core::link::Dialect::St7570>
+        <div class="cards" hidden=move || !st7570.get()>
             <super::sfsk_setup::SetupCard/>
         </div>
         <div class="mib-list">
             {move || {
-                let (list, dialect) = objects.get();
-                list.iter()
+                let dialect = if st7570.get() { Dialect::St7570 } else { Dialect::St7580 };
+                plm_core::chip::for_dialect(dialect).mib().iter()
                     .map(|o| view! { <MibCard object=o dialect=dialect/> })
                     .map(IntoAny::into_any)
                     .collect_view()
@@ -188,57 +191,72 @@ fn apply_profile(
     };
     let at = c.with_chip(|ch| mibform::index_text(ch.dialect(), index));
     message.set(Some(format!("Writing {} of {n} ({at}h)…", i + 1)));
-    c.write_mib(index, data, move |r| match r {
-        Ok(_) => c.read_mib(index, move |_| {
-            apply_profile(c, list, i + 1, message, running, cancel)
+    c.write_mib(
+        index,
+        data,
+        mib_done(move |r| match r {
+            Ok(_) => c.read_mib(
+                index,
+                mib_done(move |_| apply_profile(c, list, i + 1, message, running, cancel)),
+            ),
+            Err(why) => {
+                running.set(false);
+                message.set(Some(format!(
+                    "Stopped at object {at}h ({} of {n}): {why}",
+                    i + 1
+                )));
+            }
         }),
-        Err(why) => {
-            running.set(false);
-            message.set(Some(format!(
-                "Stopped at object {at}h ({} of {n}): {why}",
-                i + 1
-            )));
-        }
-    });
+    );
 }
 
 /// One MIB object: its fields, read, write, erase and factory default.
 #[component]
-fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl IntoView {
+fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
     let c = use_console();
     let idx = object.index;
-    let secret = dialect == plm_core::link::Dialect::St7580 && idx == index::SS_KEY as u16;
-    let read_value = Memo::new(move |_| c.modem.mib.with(|m| m.get(&idx).cloned()));
+    let secret = dialect == Dialect::St7580 && idx == index::SS_KEY as u16;
+    // The value last read, untracked: the effect below redraws the form
+    // (through `inputs`) when it changes (no memo type of its own).
+    let read_value = move || c.modem.mib.with_untracked(|m| m.get(&idx).cloned());
     let inputs = crate::views::widgets::signal(inputs_of(object, object.default));
     const NOT_READ: &str = "not read yet: the form shows the factory default";
     let status = crate::views::widgets::signal(String::from(NOT_READ));
-    Effect::new(move |_| {
-        if let Some(v) = read_value.get() {
-            inputs.set(inputs_of(object, &v));
-            // Read elsewhere (Read all, a profile, the set-up card): say so
-            // instead of "not read yet".
-            if status.with_untracked(|s| s == NOT_READ) {
-                status.set("read from the modem".into());
+    Effect::new(move |last: Option<Option<Vec<u8>>>| {
+        let value = c.modem.mib.with(|m| m.get(&idx).cloned());
+        if last.as_ref() != Some(&value) {
+            match &value {
+                Some(v) => {
+                    inputs.set(inputs_of(object, v));
+                    // Read elsewhere (Read all, a profile, the set-up
+                    // card): say so instead of "not read yet".
+                    if status.with_untracked(|s| s == NOT_READ) {
+                        status.set("read from the modem".into());
+                    }
+                }
+                // Forgotten (a new connection): the form redrawn as such.
+                None => inputs.update(|_| {}),
             }
         }
+        value
     });
-    let problems = crate::views::widgets::signal(Problems::default());
+    // Why the form was refused, by field name; the object's own reason
+    // under "" (a signal of the inputs' type: no signal type of its own).
+    let problems = crate::views::widgets::signal(Inputs::default());
     let reveal = crate::views::widgets::signal(false);
-    let masked = Signal::derive(move || secret && !reveal.get());
-    let base = move || {
-        read_value
-            .get_untracked()
-            .unwrap_or_else(|| object.default.to_vec())
-    };
+    let base = move || read_value().unwrap_or_else(|| object.default.to_vec());
 
     let read = move || {
         status.set("reading…".into());
-        c.read_mib(idx, move |r| {
-            status.set(match r {
-                Ok(_) => "read from the modem".into(),
-                Err(e) => format!("not read: {e}"),
-            })
-        });
+        c.read_mib(
+            idx,
+            mib_done(move |r| {
+                status.set(match r {
+                    Ok(_) => "read from the modem".into(),
+                    Err(e) => format!("not read: {e}"),
+                })
+            }),
+        );
     };
     let write = move || {
         let data = match mibform::build(object, &base(), &inputs.get_untracked()) {
@@ -249,269 +267,302 @@ fn MibCard(object: &'static Object, dialect: plm_core::link::Dialect) -> impl In
                     Some(why) => format!("nothing sent: {why}"),
                     None => format!("nothing sent: {n} field(s) need fixing (see the reasons)"),
                 });
-                problems.set(p);
+                let mut why = p.fields;
+                if let Some(o) = p.object {
+                    why.insert("", o);
+                }
+                problems.set(why);
                 return;
             }
         };
-        problems.set(Problems::default());
+        problems.set(Inputs::default());
         status.set("writing…".into());
         let sent = data.clone();
-        c.write_mib(idx, mibform::write_data(object, &data), move |r| match r {
-            Ok(_) if !object.access.read => {
-                status.set("written (the object cannot be read back)".into())
-            }
-            Ok(_) => {
-                status.set("written; reading back…".into());
-                c.read_mib(idx, move |r| {
-                    status.set(match r {
-                        Ok(v) if v == sent => "written and read back: the modem has it".into(),
-                        Ok(_) => "written, but the modem reads back another value".into(),
-                        Err(e) => format!("written, but not read back: {e}"),
-                    })
-                });
-            }
-            Err(why) => status.set(format!("not written: {why}")),
-        });
+        c.write_mib(
+            idx,
+            mibform::write_data(object, &data),
+            mib_done(move |r| match r {
+                Ok(_) if !object.access.read => {
+                    status.set("written (the object cannot be read back)".into())
+                }
+                Ok(_) => {
+                    status.set("written; reading back…".into());
+                    c.read_mib(
+                        idx,
+                        mib_done(move |r| {
+                            status.set(match r {
+                                Ok(v) if v == sent => {
+                                    "written and read back: the modem has it".into()
+                                }
+                                Ok(_) => "written, but the modem reads back another value".into(),
+                                Err(e) => format!("written, but not read back: {e}"),
+                            })
+                        }),
+                    );
+                }
+                Err(why) => status.set(format!("not written: {why}")),
+            }),
+        );
     };
     let erase = move || {
         status.set("erasing…".into());
-        c.erase_mib(idx, move |r| match r {
-            Ok(_) => {
-                status.set("erased; reading back…".into());
-                c.read_mib(idx, move |r| {
-                    status.set(match r {
-                        Ok(_) => "erased and read back".into(),
-                        Err(e) => format!("erased, but not read back: {e}"),
-                    })
-                });
-            }
-            Err(why) => status.set(format!("not erased: {why}")),
-        });
+        c.erase_mib(
+            idx,
+            mib_done(move |r| match r {
+                Ok(_) => {
+                    status.set("erased; reading back…".into());
+                    c.read_mib(
+                        idx,
+                        mib_done(move |r| {
+                            status.set(match r {
+                                Ok(_) => "erased and read back".into(),
+                                Err(e) => format!("erased, but not read back: {e}"),
+                            })
+                        }),
+                    );
+                }
+                Err(why) => status.set(format!("not erased: {why}")),
+            }),
+        );
     };
     let load_default = move || {
         inputs.set(inputs_of(object, object.default));
-        problems.set(Problems::default());
+        problems.set(Inputs::default());
         status.set("factory default loaded into the form: Write to send it".into());
     };
-    let diff = move || {
-        let v = read_value.get()?;
-        let d = mibform::differences(object, &v, object.default);
-        Some(if d.is_empty() {
-            "equal to the factory default".to_string()
-        } else {
-            let names: Vec<_> = d.iter().map(|f| f.label).collect();
-            format!(
-                "{} field(s) differ from the factory default: {}",
-                d.len(),
-                names.join(", ")
-            )
-        })
-    };
-    let writable = object.access.write;
-
     view! {
         <article class="card mib" id=format!("mib-{}", mibform::index_text(dialect, idx).to_ascii_lowercase())>
-            <header>
-                <h3>
-                    <span class="index">{format!("{}h", mibform::index_text(dialect, idx))}</span>
-                    " "
-                    {object.name}
-                </h3>
-                <span class="access" title="Access">{object.access.label()}</span>
-                <span class="muted">{object.section}</span>
-            </header>
-            <div class="actions">
-                {object.access.read.then(|| action_button("read", "Read", read))}
-                {writable
-                    .then(|| {
-                        view! {
-                            {action_button("write", "Write", write)}
-                            {action_button("default", "Factory default", load_default)}
-                        }
-                    })}
-                {object
-                    .access
-                    .erase
-                    .then(|| action_button("erase", "Erase", erase))}
-                {secret
-                    .then(|| {
-                        view! {
-                            <label class="reveal">
-                                <input
-                                    type="checkbox"
-                                    data-action="reveal"
-                                    prop:checked=move || reveal.get()
-                                    on:change=on_event(move |ev| reveal.set(event_target_checked(&ev)))
-                                />
-                                " Reveal key"
-                            </label>
-                        }
-                    })}
-            </div>
-            <p class="status" data-role="status">{move || status.get()}</p>
-            {move || {
-                problems
-                    .with(|p| p.object.clone())
-                    .map(|o| view! { <p class="problem">{o}</p> })
-            }}
-            <table class="fields">
-                <thead>
-                    <tr>
-                        <th>"Field"</th>
-                        <th>"Value"</th>
-                        <th>"Allowed"</th>
-                        <th>"Factory default"</th>
-                        <th></th>
-                    </tr>
-                </thead>
-                <tbody>
-                    {object
-                        .fields
-                        .iter()
-                        .map(|f| {
-                            view! {
-                                <FieldRow
-                                    field=f
-                                    object=object
-                                    read_value=read_value
-                                    inputs=inputs
-                                    problems=problems
-                                    masked=masked
-                                    editable=writable && f.settable
-                                />
-                            }
-                        })
-                        .map(IntoAny::into_any).collect_view()}
-                </tbody>
-            </table>
-            <p class="diff" data-role="diff">{diff}</p>
+            <header inner_html=header_html(object, dialect)></header>
+            // The actions as HTML, their clicks handled by one listener
+            // by the `data-action` clicked.
+            <div
+                class="actions"
+                inner_html=actions_html(object, secret)
+                on:click=on_click(move |ev| match action_of(&ev).as_str() {
+                    "read" => read(),
+                    "write" => write(),
+                    "default" => load_default(),
+                    "erase" => erase(),
+                    "reveal" => reveal.set(event_target_checked(&ev)),
+                    _ => {}
+                })
+            ></div>
+            // Status, the form and what differs, written as HTML in one go;
+            // what is typed goes to `inputs` untracked (the form is not
+            // rewritten under the typing), read back by the delegated
+            // listener from the input's `name`.
+            <div
+                inner_html=move || {
+                    card_html(
+                        object,
+                        &status.get(),
+                        &problems.get(),
+                        read_value().as_deref(),
+                        &inputs.get(),
+                        secret && !reveal.get(),
+                    )
+                }
+                on:input=on_event(move |ev| typed(object, inputs, &ev))
+            ></div>
         </article>
     }
 }
 
-/// One field: label, input (or value), what is allowed, the factory
-/// default, and why the form refused it.
-#[component]
-fn FieldRow(
-    field: &'static Field,
-    object: &'static Object,
-    read_value: Memo<Option<Vec<u8>>>,
-    inputs: RwSignal<Inputs>,
-    problems: RwSignal<Problems>,
-    masked: Signal<bool>,
-    editable: bool,
-) -> impl IntoView {
-    let name = field.name;
-    let current = move || read_value.get().unwrap_or_else(|| object.default.to_vec());
-    // Reserved and unused bits are shown only when they are not zero.
-    let visible = move || field.settable || field.get(&current()).is_some_and(|v| v != 0);
-    let differs = move || {
-        read_value
-            .get()
-            .is_some_and(|v| field.read(&v) != field.read(object.default))
-    };
-    let secret = move |text: String| {
-        if masked.get() {
-            "••••••••".to_string()
-        } else {
-            text
-        }
-    };
-    let allowed = match field.kind {
-        Kind::Bytes => format!("{} bytes, hex", field.size),
-        Kind::Flag => "yes / no".to_string(),
-        // The select lists the choices.
-        Kind::Enum(_) if editable => String::new(),
-        _ => field.allowed(),
-    };
-    let value = if editable {
-        field_input(field, inputs, masked).into_any()
-    } else {
-        view! { <span class="value">{move || secret(mibform::show(field, &current()))}</span> }
-            .into_any()
-    };
-    view! {
-        <tr
-            hidden=move || !visible()
-            class:differs=differs
-            class:invalid=move || problems.with(|p| p.fields.contains_key(name))
-            data-field=name
-        >
-            <th>
-                {field.label}
-                {(!field.unit.is_empty()).then(|| format!(" ({})", field.unit))}
-            </th>
-            <td>{value}</td>
-            <td class="muted">{allowed}</td>
-            <td class="muted">{move || secret(mibform::show(field, object.default))}</td>
-            <td class="problem" data-role="problem">
-                {move || problems.with(|p| p.fields.get(name).cloned())}
-            </td>
-        </tr>
-    }
+/// A card's heading: index, name, access and where the manual has it.
+fn header_html(object: &'static Object, dialect: Dialect) -> String {
+    format!(
+        "<h3><span class=\"index\">{}h</span> {}</h3><span class=\"access\" title=\"Access\">{}</span><span class=\"muted\">{}</span>",
+        mibform::index_text(dialect, object.index),
+        escape(object.name),
+        escape(object.access.label()),
+        escape(object.section)
+    )
 }
 
-/// The input of an editable field, by its kind.
-fn field_input(field: &'static Field, inputs: RwSignal<Inputs>, masked: Signal<bool>) -> AnyView {
-    let name = field.name;
-    let value = move || inputs.with(|m| m.get(name).cloned().unwrap_or_default());
-    let set = move |v: String| {
-        inputs.update(|m| {
-            m.insert(name, v);
-        })
-    };
-    match field.kind {
-        Kind::Enum(names) => view! {
-            <select name=name on:change=on_event(move |ev| set(event_target_value(&ev)))>
-                {names
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, n)| !n.is_empty() && **n != "Reserved")
-                    .map(|(i, n)| {
-                        let raw = i.to_string();
-                        let r = raw.clone();
-                        view! {
-                            <option value=raw selected=move || value() == r>
-                                {n.to_string()}
-                            </option>
-                        }
-                    })
-                    .map(IntoAny::into_any).collect_view()}
-            </select>
+/// A card's buttons, by what the object allows, and the key's Reveal.
+fn actions_html(object: &'static Object, secret: bool) -> String {
+    let a = &object.access;
+    let mut h = String::new();
+    for (on, action, label) in [
+        (a.read, "read", "Read"),
+        (a.write, "write", "Write"),
+        (a.write, "default", "Factory default"),
+        (a.erase, "erase", "Erase"),
+    ] {
+        if on {
+            h.push_str(&format!(
+                "<button data-action=\"{action}\">{label}</button>"
+            ));
         }
-        .into_any(),
-        Kind::Flag => view! {
-            <input
-                type="checkbox"
-                name=name
-                prop:checked=move || value() == "1"
-                on:change=on_event(move |ev| set(if event_target_checked(&ev) { "1" } else { "0" }.into()))
-            />
-        }
-        .into_any(),
-        Kind::Bytes => view! {
-            <input
-                type=move || if masked.get() { "password" } else { "text" }
-                class="hex"
-                name=name
-                autocomplete="off"
-                spellcheck="false"
-                size="34"
-                prop:value=value
-                on:input=on_event(move |ev| set(event_target_value(&ev)))
-            />
-        }
-        .into_any(),
-        _ => view! {
-            <input
-                type="text"
-                inputmode="numeric"
-                name=name
-                size="10"
-                prop:value=value
-                on:input=on_event(move |ev| set(event_target_value(&ev)))
-            />
-        }
-        .into_any(),
     }
+    if secret {
+        h.push_str("<label class=\"reveal\"><input type=\"checkbox\" data-action=\"reveal\"> Reveal key</label>");
+    }
+    h
+}
+
+/// The `data-action` of what a click was on (a button, the Reveal box).
+fn action_of(ev: &web_sys::MouseEvent) -> String {
+    use wasm_bindgen::JsCast;
+    ev.target()
+        .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+        .and_then(|e| e.closest("[data-action]").ok().flatten())
+        .and_then(|e| e.get_attribute("data-action"))
+        .unwrap_or_default()
+}
+
+/// What is typed into a field's input (found by its `name`), into
+/// `inputs` without redrawing the form.
+fn typed(object: &'static Object, inputs: RwSignal<Inputs>, ev: &web_sys::Event) {
+    use wasm_bindgen::JsCast;
+    let name = ev
+        .target()
+        .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+        .and_then(|e| e.get_attribute("name"))
+        .unwrap_or_default();
+    let Some(field) = object.fields.iter().find(|f| f.name == name) else {
+        return;
+    };
+    let text = match field.kind {
+        Kind::Flag => String::from(if event_target_checked(ev) { "1" } else { "0" }),
+        _ => event_target_value(ev),
+    };
+    inputs.update_untracked(|m| m.insert(field.name, text));
+}
+
+/// A card's status, refusal, fields table and differences from the
+/// factory default, as HTML: one row per field with its label, input (or
+/// value), what is allowed, the factory default, and why the form refused
+/// it. `read` is the value last read, `masked` hides the key's values.
+fn card_html(
+    object: &'static Object,
+    status: &str,
+    problems: &Inputs,
+    read: Option<&[u8]>,
+    inputs: &Inputs,
+    masked: bool,
+) -> String {
+    use std::fmt::Write;
+    let secret = |text: String| {
+        if masked {
+            "••••••••".to_string()
+        } else {
+            escape(&text)
+        }
+    };
+    let current = read.unwrap_or(object.default);
+    let mut h = format!(
+        "<p class=\"status\" data-role=\"status\">{}</p>",
+        escape(status)
+    );
+    if let Some(o) = problems.get("") {
+        let _ = write!(h, "<p class=\"problem\">{}</p>", escape(o));
+    }
+    h.push_str("<table class=\"fields\"><thead><tr><th>Field</th><th>Value</th><th>Allowed</th><th>Factory default</th><th></th></tr></thead><tbody>");
+    for field in object.fields {
+        let name = field.name;
+        let editable = object.access.write && field.settable;
+        // Reserved and unused bits are shown only when they are not zero.
+        let visible = field.settable || field.get(current).is_some_and(|v| v != 0);
+        let differs = read.is_some_and(|v| field.read(v) != field.read(object.default));
+        let invalid = problems.get(name);
+        let _ = write!(
+            h,
+            "<tr data-field=\"{name}\" class=\"{}{}\"{}><th>{}{}</th><td>",
+            if differs { "differs " } else { "" },
+            if invalid.is_some() { "invalid" } else { "" },
+            if visible { "" } else { " hidden" },
+            escape(field.label),
+            if field.unit.is_empty() {
+                String::new()
+            } else {
+                escape(&format!(" ({})", field.unit))
+            },
+        );
+        let value = escape(&inputs.get(name).cloned().unwrap_or_default());
+        match field.kind {
+            _ if !editable => {
+                let _ = write!(
+                    h,
+                    "<span class=\"value\">{}</span>",
+                    secret(mibform::show(field, current))
+                );
+            }
+            Kind::Enum(names) => {
+                let _ = write!(h, "<select name=\"{name}\">");
+                for (i, n) in names.iter().enumerate() {
+                    if !n.is_empty() && *n != "Reserved" {
+                        let i = i.to_string();
+                        let _ = write!(
+                            h,
+                            "<option value=\"{i}\"{}>{}</option>",
+                            if value == i { " selected" } else { "" },
+                            escape(n)
+                        );
+                    }
+                }
+                h.push_str("</select>");
+            }
+            Kind::Flag => {
+                let _ = write!(
+                    h,
+                    "<input type=\"checkbox\" name=\"{name}\"{}>",
+                    if value == "1" { " checked" } else { "" }
+                );
+            }
+            Kind::Bytes => {
+                let _ = write!(
+                    h,
+                    "<input type=\"{}\" class=\"hex\" name=\"{name}\" autocomplete=\"off\" spellcheck=\"false\" size=\"34\" value=\"{value}\">",
+                    if masked { "password" } else { "text" }
+                );
+            }
+            _ => {
+                let _ = write!(
+                    h,
+                    "<input type=\"text\" inputmode=\"numeric\" name=\"{name}\" size=\"10\" value=\"{value}\">"
+                );
+            }
+        }
+        let allowed = match field.kind {
+            Kind::Bytes => format!("{} bytes, hex", field.size),
+            Kind::Flag => "yes / no".to_string(),
+            // The select lists the choices.
+            Kind::Enum(_) if editable => String::new(),
+            _ => field.allowed(),
+        };
+        let _ = write!(
+            h,
+            "</td><td class=\"muted\">{}</td><td class=\"muted\">{}</td><td class=\"problem\" data-role=\"problem\">{}</td></tr>",
+            escape(&allowed),
+            secret(mibform::show(field, object.default)),
+            escape(invalid.map_or("", |s| s))
+        );
+    }
+    h.push_str("</tbody></table><p class=\"diff\" data-role=\"diff\">");
+    if let Some(v) = read {
+        let d = mibform::differences(object, v, object.default);
+        if d.is_empty() {
+            h.push_str("equal to the factory default");
+        } else {
+            let names: Vec<_> = d.iter().map(|f| f.label).collect();
+            let _ = write!(
+                h,
+                "{} field(s) differ from the factory default: {}",
+                d.len(),
+                escape(&names.join(", "))
+            );
+        }
+    }
+    h.push_str("</p>");
+    h
+}
+
+/// What a MIB request does when it is done, boxed: `Console::read_mib`
+/// and its siblings are generic over it, so each request of these views
+/// shares one instance of their code instead of one per closure.
+pub(super) fn mib_done(
+    f: impl FnOnce(Result<Vec<u8>, String>) + 'static,
+) -> Box<dyn FnOnce(Result<Vec<u8>, String>)> {
+    Box::new(f)
 }

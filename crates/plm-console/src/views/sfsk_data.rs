@@ -5,7 +5,7 @@
 
 use super::network::send;
 use super::seconds;
-use super::widgets::{button, note, on_event, text_input, text_table};
+use super::widgets::{button, note, set_checked, set_value, text_input, text_table};
 use crate::network::{address_text, named};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -57,7 +57,7 @@ fn payload(text: &str, hex: bool) -> Result<Vec<u8>, String> {
 fn SendCard() -> impl IntoView {
     let c = use_console();
     let da = crate::views::widgets::signal("001".to_string());
-    let ic = crate::views::widgets::signal(0u8);
+    let ic = crate::views::widgets::signal("0".to_string());
     let text = crate::views::widgets::signal("?".to_string());
     let hex = crate::views::widgets::signal(false);
     let problem = crate::views::widgets::signal(None::<String>);
@@ -81,7 +81,7 @@ fn SendCard() -> impl IntoView {
                         data.len()
                     )));
                 }
-                let ic = ic.get_untracked();
+                let ic = ic.get_untracked().parse().unwrap_or(0);
                 Command::MacDataRequest(MacData {
                     credit: Credit { ic, cc: ic, dc: 0 },
                     // SA is the modem's own (Table 41 sends it as 0).
@@ -122,6 +122,9 @@ fn SendCard() -> impl IntoView {
             }))
         });
     };
+    let phy = move || layer() == Layer::Phy;
+    // IC 0 to 7 (repetitions), 0 first; only the select changes `ic`.
+    const IC_OPTIONS: &str = "<option value=\"0\">0</option><option value=\"1\">1</option><option value=\"2\">2</option><option value=\"3\">3</option><option value=\"4\">4</option><option value=\"5\">5</option><option value=\"6\">6</option><option value=\"7\">7</option>";
     view! {
         <article class="card wide" id="sfsk-send">
             <h3>"Send a frame"</h3>
@@ -130,14 +133,12 @@ fn SendCard() -> impl IntoView {
                 Layer::Phy => "PHY mode: CMD_DataRequest (Table 40), one 38-byte P_SDU (padded with 00h).",
             }}</p>
             <div class="form-row">
-                <label hidden=move || layer() == Layer::Phy>"DA "{text_input("sfsk-da", "", "001 or BROADCAST", Some(12), da)}</label>
-                <label hidden=move || layer() == Layer::Phy>"IC "
-                    <select id="sfsk-ic" on:change=on_event(move |ev| ic.set(event_target_value(&ev).parse().unwrap_or(0)))>
-                        {(0..=7u8).map(|i| view! { <option value=i.to_string() selected=move || ic.get() == i>{i}</option> }).collect_view()}
-                    </select>
+                <label hidden=phy>"DA "{text_input("sfsk-da", "", "001 or BROADCAST", Some(12), da)}</label>
+                <label hidden=phy>"IC "
+                    <select id="sfsk-ic" inner_html=IC_OPTIONS on:change=set_value(ic)></select>
                 </label>
                 <label>"Payload "{text_input("sfsk-payload", "payload", "", None, text)}</label>
-                <label><input type="checkbox" id="sfsk-hex" prop:checked=move || hex.get() on:change=on_event(move |ev| hex.set(event_target_checked(&ev)))/>" hex"</label>
+                <label><input type="checkbox" id="sfsk-hex" on:change=set_checked(hex)/>" hex"</label>
                 {button("sfsk-send-btn", "Send", "", send_frame)}
             </div>
             {note("sfsk-problem", "problem", problem)}

@@ -3,7 +3,6 @@
 //! [`Plot`] into elements.
 
 use super::seconds;
-use leptos::prelude::*;
 use plm_core::time::Instant;
 
 /// Indications plotted at most (the newest).
@@ -316,101 +315,100 @@ fn n(v: f64) -> String {
     super::fixed(v, 1)
 }
 
-/// The drawing: `<svg id="snr-plot">` with one `circle.snr-point` per
-/// marker.
-pub fn draw(plot: Plot) -> impl IntoView {
-    let y_ticks = plot
-        .y_ticks
-        .into_iter()
-        .map(|t| {
-            view! {
-                <line class="snr-grid" x1=n(LEFT) x2=n(RIGHT) y1=n(t.at) y2=n(t.at)></line>
-                <text class="snr-tick snr-y-tick" x=n(LEFT - 6.0) y=n(t.at)>
-                    {t.label}
-                </text>
-            }
-        })
-        .map(IntoAny::into_any)
-        .collect_view();
-    let x_ticks = plot
-        .x_ticks
-        .into_iter()
-        .map(|t| {
-            view! {
-                <line class="snr-axis" x1=n(t.at) x2=n(t.at) y1=n(BOTTOM) y2=n(BOTTOM + 4.0)></line>
-                <text class="snr-tick snr-x-tick" x=n(t.at) y=n(BOTTOM + 17.0)>
-                    {t.label}
-                </text>
-            }
-        })
-        .map(IntoAny::into_any)
-        .collect_view();
-    let legend = plot
-        .legend
-        .into_iter()
-        .map(|(kind, x)| {
-            view! {
-                <circle
-                    class=format!("snr-key {}", kind.class())
-                    cx=n(x + RADIUS)
-                    cy=n(TOP - 14.0)
-                    r=n(RADIUS)
-                ></circle>
-                <text class="snr-legend" x=n(x + 2.0 * RADIUS + 5.0) y=n(TOP - 14.0)>
-                    {kind.label()}
-                </text>
-            }
-        })
-        .map(IntoAny::into_any)
-        .collect_view();
-    let markers = plot
-        .markers
-        .into_iter()
-        .map(|m| {
-            view! {
-                <circle
-                    class=format!("snr-point {}", m.kind.class())
-                    cx=n(m.cx)
-                    cy=n(m.cy)
-                    r=n(RADIUS)
-                >
-                    <title>{m.title}</title>
-                </circle>
-            }
-        })
-        .map(IntoAny::into_any)
-        .collect_view();
+/// The drawing as HTML: `<svg id="snr-plot">` with one `circle.snr-point`
+/// per marker. Written as text in one go (as the tables of text): a
+/// drawing of elements cost the console's wasm a copy of each element's
+/// code.
+pub fn draw(plot: &Plot) -> String {
+    use super::widgets::escape;
+    use std::fmt::Write;
     let middle = (TOP + BOTTOM) / 2.0;
-    view! {
-        <svg
-            id="snr-plot"
-            class="snr-plot"
-            viewBox=format!("0 0 {} {}", n(WIDTH), n(HEIGHT))
-            role="img"
-            aria-label="SNR of the received frames over time"
-        >
-            {y_ticks}
-            {x_ticks}
-            <line class="snr-axis" x1=n(LEFT) x2=n(LEFT) y1=n(TOP) y2=n(BOTTOM)></line>
-            <line class="snr-axis" x1=n(LEFT) x2=n(RIGHT) y1=n(BOTTOM) y2=n(BOTTOM)></line>
-            <text class="snr-title" x=n((LEFT + RIGHT) / 2.0) y=n(HEIGHT - 6.0)>
-                "time (s)"
-            </text>
-            <text
-                class="snr-title"
-                x=n(16.0)
-                y=n(middle)
-                transform=format!("rotate(-90 16 {})", n(middle))
-            >
-                "SNR (dB)"
-            </text>
-            {legend}
-            <text class="snr-count" x=n(RIGHT) y=n(TOP - 14.0)>
-                {plot.count}
-            </text>
-            {markers}
-        </svg>
+    let mut h = format!(
+        "<svg id=\"snr-plot\" class=\"snr-plot\" viewBox=\"0 0 {} {}\" role=\"img\" aria-label=\"SNR of the received frames over time\">",
+        n(WIDTH),
+        n(HEIGHT)
+    );
+    let line = |h: &mut String, class: &str, x1: f64, x2: f64, y1: f64, y2: f64| {
+        let _ = write!(
+            h,
+            "<line class=\"{class}\" x1=\"{}\" x2=\"{}\" y1=\"{}\" y2=\"{}\"></line>",
+            n(x1),
+            n(x2),
+            n(y1),
+            n(y2)
+        );
+    };
+    let text = |h: &mut String, class: &str, x: f64, y: f64, extra: &str, body: &str| {
+        let _ = write!(
+            h,
+            "<text class=\"{class}\" x=\"{}\" y=\"{}\"{extra}>{}</text>",
+            n(x),
+            n(y),
+            escape(body)
+        );
+    };
+    for t in &plot.y_ticks {
+        line(&mut h, "snr-grid", LEFT, RIGHT, t.at, t.at);
+        text(
+            &mut h,
+            "snr-tick snr-y-tick",
+            LEFT - 6.0,
+            t.at,
+            "",
+            &t.label,
+        );
     }
+    for t in &plot.x_ticks {
+        line(&mut h, "snr-axis", t.at, t.at, BOTTOM, BOTTOM + 4.0);
+        text(
+            &mut h,
+            "snr-tick snr-x-tick",
+            t.at,
+            BOTTOM + 17.0,
+            "",
+            &t.label,
+        );
+    }
+    line(&mut h, "snr-axis", LEFT, LEFT, TOP, BOTTOM);
+    line(&mut h, "snr-axis", LEFT, RIGHT, BOTTOM, BOTTOM);
+    text(
+        &mut h,
+        "snr-title",
+        (LEFT + RIGHT) / 2.0,
+        HEIGHT - 6.0,
+        "",
+        "time (s)",
+    );
+    let rotate = format!(" transform=\"rotate(-90 16 {})\"", n(middle));
+    text(&mut h, "snr-title", 16.0, middle, &rotate, "SNR (dB)");
+    let circle = |h: &mut String, class: &str, kind: Kind, cx: f64, cy: f64, title: &str| {
+        let _ = write!(
+            h,
+            "<circle class=\"{class} {}\" cx=\"{}\" cy=\"{}\" r=\"{}\">{title}</circle>",
+            kind.class(),
+            n(cx),
+            n(cy),
+            n(RADIUS)
+        );
+    };
+    for &(kind, x) in &plot.legend {
+        circle(&mut h, "snr-key", kind, x + RADIUS, TOP - 14.0, "");
+        text(
+            &mut h,
+            "snr-legend",
+            x + 2.0 * RADIUS + 5.0,
+            TOP - 14.0,
+            "",
+            kind.label(),
+        );
+    }
+    text(&mut h, "snr-count", RIGHT, TOP - 14.0, "", &plot.count);
+    for m in &plot.markers {
+        let title = format!("<title>{}</title>", escape(&m.title));
+        circle(&mut h, "snr-point", m.kind, m.cx, m.cy, &title);
+    }
+    h.push_str("</svg>");
+    h
 }
 
 #[cfg(test)]

@@ -174,3 +174,14 @@ pub fn on_click(
 pub fn signal<T: Send + Sync + 'static>(value: T) -> RwSignal<T> {
     RwSignal::new(value)
 }
+
+/// A `change` or `input` handler keeping the target's value in `value`
+/// (a select, an input): one closure for every such form control.
+pub fn set_value(value: RwSignal<String>) -> Box<dyn FnMut(web_sys::Event)> {
+    Box::new(move |ev| value.set(event_target_value(&ev)))
+}
+
+/// A `change` handler keeping a checkbox's state in `value`.
+pub fn set_checked(value: RwSignal<bool>) -> Box<dyn FnMut(web_sys::Event)> {
+    Box::new(move |ev| value.set(event_target_checked(&ev)))
+}
