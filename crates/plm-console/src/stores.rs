@@ -812,4 +812,3 @@ enum MibOp {
     Write(Vec<u8>),
     Erase,
 }
-

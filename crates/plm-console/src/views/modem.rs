@@ -48,26 +48,23 @@ pub fn ModemView() -> impl IntoView {
         let failed = crate::views::widgets::signal(0usize);
         progress.set(Some(format!("Reading 0 of {total}…")));
         for i in readable {
-            c.read_mib(
-                i,
-                mib_done(move |r| {
-                    if r.is_err() {
-                        failed.update(|f| *f += 1);
-                    }
-                    done.update(|d| *d += 1);
-                    let (d, f) = (done.get_untracked(), failed.get_untracked());
-                    progress.set(Some(if d < total {
-                        format!("Reading {d} of {total}…")
-                    } else if f == 0 {
-                        format!("Read all {total} objects.")
-                    } else {
-                        format!(
-                            "Read {} of {total} objects; {f} failed (see each object).",
-                            d - f
-                        )
-                    }));
-                }),
-            );
+            c.read_mib(i, move |r| {
+                if r.is_err() {
+                    failed.update(|f| *f += 1);
+                }
+                done.update(|d| *d += 1);
+                let (d, f) = (done.get_untracked(), failed.get_untracked());
+                progress.set(Some(if d < total {
+                    format!("Reading {d} of {total}…")
+                } else if f == 0 {
+                    format!("Read all {total} objects.")
+                } else {
+                    format!(
+                        "Read {} of {total} objects; {f} failed (see each object).",
+                        d - f
+                    )
+                }));
+            });
         }
     };
     view! {
@@ -191,23 +188,18 @@ fn apply_profile(
     };
     let at = c.with_chip(|ch| mibform::index_text(ch.dialect(), index));
     message.set(Some(format!("Writing {} of {n} ({at}h)…", i + 1)));
-    c.write_mib(
-        index,
-        data,
-        mib_done(move |r| match r {
-            Ok(_) => c.read_mib(
-                index,
-                mib_done(move |_| apply_profile(c, list, i + 1, message, running, cancel)),
-            ),
-            Err(why) => {
-                running.set(false);
-                message.set(Some(format!(
-                    "Stopped at object {at}h ({} of {n}): {why}",
-                    i + 1
-                )));
-            }
+    c.write_mib(index, data, move |r| match r {
+        Ok(_) => c.read_mib(index, move |_| {
+            apply_profile(c, list, i + 1, message, running, cancel)
         }),
-    );
+        Err(why) => {
+            running.set(false);
+            message.set(Some(format!(
+                "Stopped at object {at}h ({} of {n}): {why}",
+                i + 1
+            )));
+        }
+    });
 }
 
 /// One MIB object: its fields, read, write, erase and factory default.
@@ -248,15 +240,12 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
 
     let read = move || {
         status.set("reading…".into());
-        c.read_mib(
-            idx,
-            mib_done(move |r| {
-                status.set(match r {
-                    Ok(_) => "read from the modem".into(),
-                    Err(e) => format!("not read: {e}"),
-                })
-            }),
-        );
+        c.read_mib(idx, move |r| {
+            status.set(match r {
+                Ok(_) => "read from the modem".into(),
+                Err(e) => format!("not read: {e}"),
+            })
+        });
     };
     let write = move || {
         let data = match mibform::build(object, &base(), &inputs.get_untracked()) {
@@ -278,52 +267,37 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
         problems.set(Inputs::default());
         status.set("writing…".into());
         let sent = data.clone();
-        c.write_mib(
-            idx,
-            mibform::write_data(object, &data),
-            mib_done(move |r| match r {
-                Ok(_) if !object.access.read => {
-                    status.set("written (the object cannot be read back)".into())
-                }
-                Ok(_) => {
-                    status.set("written; reading back…".into());
-                    c.read_mib(
-                        idx,
-                        mib_done(move |r| {
-                            status.set(match r {
-                                Ok(v) if v == sent => {
-                                    "written and read back: the modem has it".into()
-                                }
-                                Ok(_) => "written, but the modem reads back another value".into(),
-                                Err(e) => format!("written, but not read back: {e}"),
-                            })
-                        }),
-                    );
-                }
-                Err(why) => status.set(format!("not written: {why}")),
-            }),
-        );
+        c.write_mib(idx, mibform::write_data(object, &data), move |r| match r {
+            Ok(_) if !object.access.read => {
+                status.set("written (the object cannot be read back)".into())
+            }
+            Ok(_) => {
+                status.set("written; reading back…".into());
+                c.read_mib(idx, move |r| {
+                    status.set(match r {
+                        Ok(v) if v == sent => "written and read back: the modem has it".into(),
+                        Ok(_) => "written, but the modem reads back another value".into(),
+                        Err(e) => format!("written, but not read back: {e}"),
+                    })
+                });
+            }
+            Err(why) => status.set(format!("not written: {why}")),
+        });
     };
     let erase = move || {
         status.set("erasing…".into());
-        c.erase_mib(
-            idx,
-            mib_done(move |r| match r {
-                Ok(_) => {
-                    status.set("erased; reading back…".into());
-                    c.read_mib(
-                        idx,
-                        mib_done(move |r| {
-                            status.set(match r {
-                                Ok(_) => "erased and read back".into(),
-                                Err(e) => format!("erased, but not read back: {e}"),
-                            })
-                        }),
-                    );
-                }
-                Err(why) => status.set(format!("not erased: {why}")),
-            }),
-        );
+        c.erase_mib(idx, move |r| match r {
+            Ok(_) => {
+                status.set("erased; reading back…".into());
+                c.read_mib(idx, move |r| {
+                    status.set(match r {
+                        Ok(_) => "erased and read back".into(),
+                        Err(e) => format!("erased, but not read back: {e}"),
+                    })
+                });
+            }
+            Err(why) => status.set(format!("not erased: {why}")),
+        });
     };
     let load_default = move || {
         inputs.set(inputs_of(object, object.default));
@@ -556,13 +530,4 @@ fn card_html(
     }
     h.push_str("</p>");
     h
-}
-
-/// What a MIB request does when it is done, boxed: `Console::read_mib`
-/// and its siblings are generic over it, so each request of these views
-/// shares one instance of their code instead of one per closure.
-pub(super) fn mib_done(
-    f: impl FnOnce(Result<Vec<u8>, String>) + 'static,
-) -> Box<dyn FnOnce(Result<Vec<u8>, String>)> {
-    Box::new(f)
 }

@@ -3,7 +3,6 @@
 //! the checks of the declarative MIB ([`crate::mibform::build`]), and for
 //! a MAC Server its local address (0001h, Table 74).
 
-use super::modem::mib_done;
 use super::widgets::{button, note, on_event, text_input};
 use crate::mibform::{build, input_text, Texts};
 use crate::stores::use_console;
@@ -113,39 +112,26 @@ pub fn SetupCard() -> impl IntoView {
         // the new mode): what the modem has is what the card says.
         let wanted = data.clone();
         let check = move |done: String| {
-            c.read_mib(
-                index::PLC_CONFIGURATION,
-                mib_done(move |r| {
-                    result.set(Some(match r {
-                        Ok(v) if v == wanted => format!("{done}, read back: the modem has it"),
-                        Ok(_) => format!("{done}, but 00A1h reads back otherwise"),
-                        Err(why) => format!("{done}; reading it back failed: {why}"),
-                    }))
-                }),
-            )
+            c.read_mib(index::PLC_CONFIGURATION, move |r| {
+                result.set(Some(match r {
+                    Ok(v) if v == wanted => format!("{done}, read back: the modem has it"),
+                    Ok(_) => format!("{done}, but 00A1h reads back otherwise"),
+                    Err(why) => format!("{done}; reading it back failed: {why}"),
+                }))
+            })
         };
-        c.write_mib(
-            index::PLC_CONFIGURATION,
-            data,
-            mib_done(move |r| match (r, local) {
-                (Err(why), _) => result.set(Some(format!("00A1h not written: {why}"))),
-                (Ok(_), None) => check(format!("{name}: 00A1h written")),
-                (Ok(_), Some(a)) => {
-                    let mut d = a.to_le_bytes().to_vec();
-                    d.extend([0, 0]);
-                    c.write_mib(
-                        index::LOCAL_INIT_MAC_ADD,
-                        d,
-                        mib_done(move |r| match r {
-                            Ok(_) => check(format!("{name} at {a:03X}h: 00A1h and 0001h written")),
-                            Err(why) => {
-                                result.set(Some(format!("00A1h written, 0001h not: {why}")))
-                            }
-                        }),
-                    )
-                }
-            }),
-        );
+        c.write_mib(index::PLC_CONFIGURATION, data, move |r| match (r, local) {
+            (Err(why), _) => result.set(Some(format!("00A1h not written: {why}"))),
+            (Ok(_), None) => check(format!("{name}: 00A1h written")),
+            (Ok(_), Some(a)) => {
+                let mut d = a.to_le_bytes().to_vec();
+                d.extend([0, 0]);
+                c.write_mib(index::LOCAL_INIT_MAC_ADD, d, move |r| match r {
+                    Ok(_) => check(format!("{name} at {a:03X}h: 00A1h and 0001h written")),
+                    Err(why) => result.set(Some(format!("00A1h written, 0001h not: {why}"))),
+                })
+            }
+        });
     };
     const MAINS: &[(&str, &str)] = &[("0", "50 Hz"), ("1", "60 Hz")];
     const RATES: &[(&str, &str)] = &[("0", "1200 bit/s"), ("1", "2400 bit/s")];

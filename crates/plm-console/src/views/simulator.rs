@@ -114,7 +114,10 @@ fn StreetCard() -> impl IntoView {
 #[component]
 fn FailureRate() -> impl IntoView {
     let c = use_console();
-    let text = crate::views::widgets::signal(super::fixed(f64::from_bits(c.sim.failure_rate.get_untracked()), 2));
+    let text = crate::views::widgets::signal(super::fixed(
+        f64::from_bits(c.sim.failure_rate.get_untracked()),
+        2,
+    ));
     let message = crate::views::widgets::signal(None::<String>);
     let apply = move || match super::decimal(&text.get_untracked()) {
         Some(rate) if (0.0..=60.0).contains(&rate) => {
@@ -293,7 +296,13 @@ fn UartCard() -> impl IntoView {
     let c = use_console();
     // Modem to host when set (a bool: a signal type the page has).
     let up = crate::views::widgets::signal(false);
-    let dir = move || if up.get_untracked() { Dir::ModemToHost } else { Dir::HostToModem };
+    let dir = move || {
+        if up.get_untracked() {
+            Dir::ModemToHost
+        } else {
+            Dir::HostToModem
+        }
+    };
     let drop = crate::views::widgets::signal("0".to_string());
     let corrupt = crate::views::widgets::signal("0".to_string());
     let delay = crate::views::widgets::signal("0".to_string());

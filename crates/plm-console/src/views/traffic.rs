@@ -169,7 +169,9 @@ fn FilterControls(filter: FilterChoice) -> impl IntoView {
         for name in (0..=255u8).filter_map(|code| chip.code_name(code)) {
             let selected = if name == chosen { " selected" } else { "" };
             kept |= name == chosen;
-            html.push_str(&format!("<option value=\"{name}\"{selected}>{name}</option>"));
+            html.push_str(&format!(
+                "<option value=\"{name}\"{selected}>{name}</option>"
+            ));
         }
         if !kept {
             filter.command.set(String::new());

@@ -19,9 +19,9 @@
 use super::fields::{mac_data, P_SDU_LEN};
 use super::types::{Address, Credit};
 use crate::field::Field;
+use crate::CrcImpl;
 use alloc::vec::Vec;
 use core::fmt;
-use crate::CrcImpl;
 use crc::{Algorithm, Crc};
 
 /// Bytes of one MAC subframe, the P_sdu of a PHY frame (3.2, 4.4).

@@ -9,11 +9,11 @@
 //! Nothing here panics: every malformed input is an error.
 
 use super::mib::ModemConfig;
+use crate::CrcImpl;
 use aes::Aes128;
 use alloc::vec::Vec;
 use cmac::{Cmac, Mac};
 use core::fmt;
-use crate::CrcImpl;
 use crc::{Crc, CRC_16_IBM_3740, CRC_32_ISO_HDLC, CRC_8_SMBUS};
 use ctr::cipher::{KeyIvInit, StreamCipher};
 

@@ -17,9 +17,9 @@
 
 use super::{image_crc, IMAGE_MAX};
 use crate::app::service::Release;
+use crate::CrcImpl;
 use alloc::format;
 use alloc::string::String;
-use crate::CrcImpl;
 use crc::{Crc, CRC_32_ISO_HDLC};
 
 /// Bytes of the interrupt vector table at the start of an image
