@@ -85,6 +85,17 @@ test('read, change, write and read back the PHY configuration', async (t) => {
   await phyRoundTrip(page, 'modem');
 });
 
+test('the SS key is masked until Reveal key is ticked', async (t) => {
+  const page = await open(t, '#modem');
+  const card = page.locator('#mib-02');
+  const key = card.locator('input[name=ss_key]');
+  assert.equal(await key.getAttribute('type'), 'password');
+  await card.locator('[data-action=reveal]').check();
+  await page.waitForFunction(() => document.querySelector('#mib-02 input[name=ss_key]').type === 'text');
+  await card.locator('[data-action=reveal]').uncheck();
+  await page.waitForFunction(() => document.querySelector('#mib-02 input[name=ss_key]').type === 'password');
+});
+
 test('a profile saved to a file and loaded back restores the configuration', async (t) => {
   const page = await open(t, '#modem');
   await page.click('#mib-read-all');
