@@ -35,7 +35,9 @@ mod wasm {
     use crate::stores::{use_console, Console};
     use crate::transport::webserial::{self, OnLost, Settings, TReqPolarity, WebSerialTransport};
     use crate::transport::LinkState;
-    use crate::views::widgets::{on_click, on_event};
+    use crate::views::widgets::{
+        checkbox, escape, html, live_button, on_click, option_html, select, text,
+    };
     use leptos::prelude::*;
     use plm_sim::BAUD_RATES;
     use std::rc::Rc;
@@ -291,45 +293,32 @@ mod wasm {
 
         let ports = move || {
             let list = labels.get();
+            let mut h = String::new();
             if list.is_empty() {
-                return view! { <option value="" selected>"no port granted yet"</option> }
-                    .into_any();
+                option_html(&mut h, "", "no port granted yet", true);
             }
-            list.into_iter()
-                .enumerate()
-                .map(|(i, l)| {
-                    view! {
-                        <option value=i.to_string() selected=move || selected.get() == Some(i)>
-                            {l}
-                        </option>
-                    }
-                })
-                .map(IntoAny::into_any)
-                .collect_view()
-                .into_any()
+            let chosen = selected.get();
+            for (i, l) in list.iter().enumerate() {
+                option_html(&mut h, &i.to_string(), l, chosen == Some(i));
+            }
+            h
         };
-        let bauds = BAUD_RATES
-            .iter()
-            .map(|&b| {
-                view! {
-                    <option value=b.to_string() selected=move || baud.get() == b>
-                        {b.to_string()}
-                    </option>
-                }
-            })
-            .map(IntoAny::into_any)
-            .collect_view();
-        let polarities = TReqPolarity::ALL
-            .into_iter()
-            .map(|p| {
-                view! {
-                    <option value=p.key() selected=move || polarity.get() == p>
-                        {p.label()}
-                    </option>
-                }
-            })
-            .map(IntoAny::into_any)
-            .collect_view();
+        let bauds = move || {
+            let chosen = baud.get();
+            let mut h = String::new();
+            for b in BAUD_RATES {
+                option_html(&mut h, &b.to_string(), &b.to_string(), b == chosen);
+            }
+            h
+        };
+        let polarities = move || {
+            let chosen = polarity.get();
+            let mut h = String::new();
+            for p in TReqPolarity::ALL {
+                option_html(&mut h, p.key(), p.label(), p == chosen);
+            }
+            h
+        };
         let controls = if supported {
             view! {
                 <p class="muted" style="margin-top: 0">
@@ -338,13 +327,7 @@ mod wasm {
                 <div style="display: grid; grid-template-columns: max-content 1fr; gap: 6px 10px; align-items: center">
                     <label for="serial-port">"Port"</label>
                     <span style="display: flex; gap: 6px">
-                        <select
-                            id="serial-port"
-                            style="flex: 1"
-                            on:change=on_event(move |ev| selected.set(event_target_value(&ev).parse().ok()))
-                        >
-                            {ports}
-                        </select>
+                        {select("serial-port", Box::new(ports), Box::new(move |v| selected.set(v.parse().ok())))}
                         {button("serial-choose", "Choose a port…", "The browser asks which port this site may use, and remembers the answer.", move || chooser.choose())}
                     </span>
                     <label
@@ -353,42 +336,27 @@ mod wasm {
                     >
                         "Baud"
                     </label>
-                    <select
-                        id="serial-baud"
-                        on:change=on_event(move |ev| {
-                            if let Ok(b) = event_target_value(&ev).parse() {
-                                baud.set(b);
-                            }
-                        })
-                    >
-                        {bauds}
-                    </select>
+                    {select("serial-baud", Box::new(bauds), Box::new(move |v| {
+                        if let Ok(b) = v.parse() {
+                            baud.set(b);
+                        }
+                    }))}
                     <label
                         for="serial-polarity"
                         title="Which RTS level pulls T_REQ low (a request to send). Straight wiring: RTS asserted = T_REQ low; through an inverting level shifter: the other."
                     >
                         "T_REQ"
                     </label>
-                    <select
-                        id="serial-polarity"
-                        on:change=on_event(move |ev| {
-                            if let Some(p) = TReqPolarity::from_key(&event_target_value(&ev)) {
-                                polarity.set(p);
-                            }
-                        })
-                    >
-                        {polarities}
-                    </select>
+                    {select("serial-polarity", Box::new(polarities), Box::new(move |v| {
+                        if let Some(p) = TReqPolarity::from_key(&v) {
+                            polarity.set(p);
+                        }
+                    }))}
                     <span></span>
                     <label
                         title="Windows' usbser driver sets RTS one call late"
                     >
-                        <input
-                            type="checkbox"
-                            id="serial-rts-twice"
-                            prop:checked=move || rts_twice.get()
-                            on:change=on_event(move |ev| rts_twice.set(event_target_checked(&ev)))
-                        />
+                        {checkbox("serial-rts-twice", Box::new(move || rts_twice.get()), Box::new(move |on| rts_twice.set(on)))}
                         " Send each RTS change twice (Windows)"
                     </label>
                 </div>
@@ -408,7 +376,7 @@ mod wasm {
                     title=if supported { "Connect to a real modem over WebSerial" } else { NO_WEB_SERIAL }
                     on:click=on_click(move |_| open.update(|o| *o = !*o))
                 >
-                    {summary}
+                    {text(Box::new(move || summary().to_string()))}
                 </button>
                 <div
                     id="serial-panel"
@@ -421,29 +389,24 @@ mod wasm {
                 >
                     {controls}
                     <div class="buttons" style="margin-top: 10px">
-                        {move || (supported).then(|| view! {
-                            <button
-                                id="serial-connect"
-                                disabled=move || busy.get() || labels.with(Vec::is_empty)
-                                on:click=on_click(move |_| chooser.connect())
-                            >
-                                {move || String::from(if active() { "Reconnect" } else { "Connect over WebSerial" })}
-                            </button>
-                        }).map(IntoAny::into_any)}
-                        <button
-                            id="serial-use-sim"
-                            disabled=move || console.conn.kind.get() == "Simulated"
-                            on:click=on_click(move |_| chooser.use_simulator())
-                        >
-                            "Use the simulated modem"
-                        </button>
+                        {supported.then(|| live_button(
+                            "serial-connect",
+                            Box::new(move || String::from(if active() { "Reconnect" } else { "Connect over WebSerial" })),
+                            Box::new(move || busy.get() || labels.with(Vec::is_empty)),
+                            Box::new(move || chooser.connect()),
+                        ))}
+                        {live_button(
+                            "serial-use-sim",
+                            Box::new(|| String::from("Use the simulated modem")),
+                            Box::new(move || console.conn.kind.get() == "Simulated"),
+                            Box::new(move || chooser.use_simulator()),
+                        )}
                         {button("serial-close", "Close", "", move || open.set(false))}
                     </div>
-                    {move || (message.with(Option::is_some)).then(|| view! {
-                        <p class="message" id="serial-message" role="status">
-                            {move || message.get().unwrap_or_default()}
-                        </p>
-                    }).map(IntoAny::into_any)}
+                    {html(Box::new(move || message.with(|m| m.as_deref().map_or(String::new(), |m| format!(
+                        "<p class=\"message\" id=\"serial-message\" role=\"status\">{}</p>",
+                        escape(m)
+                    )))))}
                 </div>
             </span>
         }
