@@ -146,10 +146,13 @@ fn PingCard() -> impl IntoView {
 #[component]
 fn StatusCard() -> impl IntoView {
     let c = use_console();
-    let byte = Memo::new(move |_| c.modem.status.get().map(|(_, b)| b));
-    let received = move || match c.modem.status.get() {
+    let html_of = move || match c.modem.status.get() {
         None => "<p class=\"muted\">No status message yet: send any request.</p>".to_string(),
-        Some((at, b)) => format!("<p>3F {b:02X}, received at {}</p>", seconds(at)),
+        Some((at, b)) => format!(
+            "<p>3F {b:02X}, received at {}</p>{}",
+            seconds(at),
+            table_html("", status::LAYOUT, &[b])
+        ),
     };
     view! {
         <article class="card" id="status">
@@ -157,11 +160,7 @@ fn StatusCard() -> impl IntoView {
             <p class="muted">
                 "The bits of the last status message (UM0932 Table 8); the modem sends one each time the host asks to send."
             </p>
-            // The table is drawn again only when the byte changes; the
-            // time of the last one is a line of its own (one status per
-            // exchange).
-            {html(Box::new(received))}
-            {html(Box::new(move || byte.get().map_or(String::new(), |b| table_html("", status::LAYOUT, &[b]))))}
+            {html(Box::new(html_of))}
         </article>
     }
 }
@@ -170,43 +169,38 @@ fn StatusCard() -> impl IntoView {
 #[component]
 fn AckLatencyCard() -> impl IntoView {
     let c = use_console();
-    // Recomputed when traffic comes: every ACK goes to the traffic log.
-    let latency = Memo::new(move |_| {
+    // Written again when traffic comes: every ACK goes to the traffic log.
+    let html_of = move || {
         c.traffic.log.track();
         c.conn.port.track();
-        c.ack_latency()
-    });
-    let simulated = move || c.conn.kind.get() == "Simulated";
-    let none = Memo::new(move |_| latency.with(|l| l.count == 0));
-    let t_ack = move || c.conn.timeouts.get().t_ack;
-    let line = move || {
-        let p = latency.with(|l| l.page);
+        let l = c.ack_latency();
+        if l.count == 0 {
+            return "<p class=\"muted\" id=\"ack-latency-value\">No frame from the modem yet.</p>".to_string();
+        }
+        let t_ack = c.conn.timeouts.get().t_ack;
+        let p = l.page;
+        let frames = if l.count as usize > ACK_SAMPLES {
+            format!("Over the last {ACK_SAMPLES} of {} frames ACKed since connecting.", l.count)
+        } else {
+            format!("{} frame(s) ACKed since connecting.", l.count)
+        };
+        let link = if c.conn.kind.get() == "Simulated" {
+            format!(
+                "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
+                millis(l.link.p99),
+                millis(l.link.max)
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)",
+            "<p id=\"ack-latency-value\"{}>ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)</p><p class=\"muted\">{frames} {link}</p>",
+            if p.max > t_ack { " class=\"problem\"" } else { "" },
             millis(p.p50),
             millis(p.p99),
             millis(p.max),
-            t_ack() / MS
+            t_ack / MS
         )
-    };
-    let late = move || latency.with(|l| l.page.max) > t_ack();
-    let frames = move || {
-        let count = latency.with(|l| l.count);
-        if count as usize > ACK_SAMPLES {
-            format!("Over the last {ACK_SAMPLES} of {count} frames ACKed since connecting.")
-        } else {
-            format!("{count} frame(s) ACKed since connecting.")
-        }
-    };
-    let link = move || {
-        let l = latency.with(|l| l.link);
-        simulated().then(|| {
-            format!(
-                "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
-                millis(l.p99),
-                millis(l.max)
-            )
-        })
     };
     view! {
         <article class="card" id="ack-latency">
@@ -214,19 +208,7 @@ fn AckLatencyCard() -> impl IntoView {
             <p class="muted">
                 "From the last byte of each modem frame to the host's ACK (UM0932 3.2.8), on the page's clock: it includes how late the page woke and any stall of the page."
             </p>
-            // Two lines of text, written again as traffic comes.
-            {html(Box::new(move || {
-                if none.get() {
-                    return "<p class=\"muted\" id=\"ack-latency-value\">No frame from the modem yet.</p>".to_string();
-                }
-                format!(
-                    "<p id=\"ack-latency-value\"{}>{}</p><p class=\"muted\">{} {}</p>",
-                    if late() { " class=\"problem\"" } else { "" },
-                    line(),
-                    frames(),
-                    link().unwrap_or_default()
-                )
-            }))}
+            {html(Box::new(html_of))}
         </article>
     }
 }
