@@ -66,9 +66,11 @@ mod wasm {
         ports: StoredValue<Vec<Port>, LocalStorage>,
         /// Their names, for the list.
         labels: RwSignal<Vec<String>>,
-        selected: RwSignal<Option<usize>>,
+        /// The index of the chosen port (a signal type the page has anyway).
+        selected: RwSignal<Option<u64>>,
         baud: RwSignal<u32>,
-        polarity: RwSignal<TReqPolarity>,
+        /// The key of the [`TReqPolarity`] chosen.
+        polarity: RwSignal<String>,
         /// Each RTS change sent twice (Windows' usbser driver).
         rts_twice: RwSignal<bool>,
         /// A port is being opened.
@@ -78,13 +80,16 @@ mod wasm {
     }
 
     impl Chooser {
+        /// The chosen port.
+        fn port(&self) -> Option<Port> {
+            let i = self.selected.get_untracked()? as usize;
+            self.ports.with_value(|p| p.get(i).cloned())
+        }
+
         /// Shows `ports`, keeping the selection on the same port, else on
         /// the one used last time, else the first.
         fn show(&self, ports: Vec<Port>, prefer: Option<Port>) {
-            let current = self
-                .selected
-                .get_untracked()
-                .and_then(|i| self.ports.with_value(|p| p.get(i).cloned()));
+            let current = self.port();
             let labels: Vec<String> = ports.iter().map(webserial::describe).collect();
             let last = load(KEY_PORT);
             let same = |want: &Port| {
@@ -100,7 +105,7 @@ mod wasm {
                 .or(if ports.is_empty() { None } else { Some(0) });
             self.ports.set_value(ports);
             self.labels.set(labels);
-            self.selected.set(selected);
+            self.selected.set(selected.map(|i| i as u64));
         }
 
         /// Asks the browser for the ports granted to this site.
@@ -152,11 +157,7 @@ mod wasm {
 
         /// Opens the selected port and makes it the session's transport.
         fn connect(self) {
-            let Some(port) = self
-                .selected
-                .get_untracked()
-                .and_then(|i| self.ports.with_value(|p| p.get(i).cloned()))
-            else {
+            let Some(port) = self.port() else {
                 self.message.set(Some(
                     "no port: choose one first (Choose a port…)".to_string(),
                 ));
@@ -165,7 +166,7 @@ mod wasm {
             let label = webserial::describe(&port);
             let settings = Settings {
                 baud: self.baud.get_untracked(),
-                polarity: self.polarity.get_untracked(),
+                polarity: TReqPolarity::from_key(&self.polarity.get_untracked()).unwrap_or_default(),
                 rts_twice: self.rts_twice.get_untracked(),
             };
             save(KEY_BAUD, &settings.baud.to_string());
@@ -257,8 +258,8 @@ mod wasm {
             ),
             polarity: crate::views::widgets::signal(
                 load(KEY_POLARITY)
-                    .and_then(|p| TReqPolarity::from_key(&p))
-                    .unwrap_or_default(),
+                    .filter(|p| TReqPolarity::from_key(p).is_some())
+                    .unwrap_or_else(|| TReqPolarity::default().key().to_string()),
             ),
             rts_twice: crate::views::widgets::signal(load(KEY_RTS_TWICE).is_some()),
             busy: crate::views::widgets::signal(false),
@@ -299,7 +300,7 @@ mod wasm {
             }
             let chosen = selected.get();
             for (i, l) in list.iter().enumerate() {
-                option_html(&mut h, &i.to_string(), l, chosen == Some(i));
+                option_html(&mut h, &i.to_string(), l, chosen == Some(i as u64));
             }
             h
         };
@@ -313,9 +314,10 @@ mod wasm {
         };
         let polarities = move || {
             let chosen = polarity.get();
+            let chosen = chosen.as_str();
             let mut h = String::new();
             for p in TReqPolarity::ALL {
-                option_html(&mut h, p.key(), p.label(), p == chosen);
+                option_html(&mut h, p.key(), p.label(), p.key() == chosen);
             }
             h
         };
@@ -348,8 +350,8 @@ mod wasm {
                         "T_REQ"
                     </label>
                     {select("serial-polarity", Box::new(polarities), Box::new(move |v| {
-                        if let Some(p) = TReqPolarity::from_key(&v) {
-                            polarity.set(p);
+                        if TReqPolarity::from_key(&v).is_some() {
+                            polarity.set(v);
                         }
                     }))}
                     <span></span>
