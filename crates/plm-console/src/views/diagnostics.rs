@@ -68,7 +68,8 @@ fn PingCard() -> impl IntoView {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));
     };
-    let history = crate::views::widgets::signal(Vec::<u64>::new());
+    // The last round trips, as written (a signal type the page has).
+    let history = crate::views::widgets::signal(Vec::<String>::new());
     let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
@@ -93,7 +94,7 @@ fn PingCard() -> impl IntoView {
                     rtt,
                 } => {
                     history.update(|h| {
-                        h.push(rtt);
+                        h.push(millis(rtt));
                         if h.len() > 10 {
                             h.remove(0);
                         }
@@ -126,13 +127,13 @@ fn PingCard() -> impl IntoView {
             </label>
             {button("ping-send", "Ping", "", ping)}
             {html(Box::new(move || {
-                let h = history.get();
-                let history = if h.is_empty() {
-                    String::new()
-                } else {
-                    let list: Vec<String> = h.iter().map(|r| millis(*r)).collect();
-                    format!("Last round trips: {}", list.join(", "))
-                };
+                let history = history.with(|h| {
+                    if h.is_empty() {
+                        String::new()
+                    } else {
+                        format!("Last round trips: {}", h.join(", "))
+                    }
+                });
                 format!(
                     "<p id=\"ping-result\"{}>{}</p><p class=\"muted\" id=\"ping-history\">{history}</p>",
                     if problem.get() { " class=\"problem\"" } else { "" },
