@@ -58,12 +58,16 @@ mod wasm {
         crate::storage::store(key, Some(value));
     }
 
+    thread_local! {
+        /// Granted ports, in the order `getPorts` gave them (one chooser
+        /// in the page, which lives as long as it).
+        static PORTS: std::cell::RefCell<Vec<Port>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+
     /// The panel's state; `Copy`, shared by the handlers.
     #[derive(Clone, Copy)]
     struct Chooser {
         console: Console,
-        /// Granted ports, in the order `getPorts` gave them.
-        ports: StoredValue<Vec<Port>, LocalStorage>,
         /// Their names, for the list.
         labels: RwSignal<Vec<String>>,
         /// The index of the chosen port (a signal type the page has anyway).
@@ -83,7 +87,7 @@ mod wasm {
         /// The chosen port.
         fn port(&self) -> Option<Port> {
             let i = self.selected.get_untracked()? as usize;
-            self.ports.with_value(|p| p.get(i).cloned())
+            PORTS.with(|p| p.borrow().get(i).cloned())
         }
 
         /// Shows `ports`, keeping the selection on the same port, else on
@@ -103,7 +107,7 @@ mod wasm {
                 .or_else(|| current.as_ref().and_then(same))
                 .or_else(|| last.and_then(|l| labels.iter().position(|x| *x == l)))
                 .or(if ports.is_empty() { None } else { Some(0) });
-            self.ports.set_value(ports);
+            PORTS.with(|p| *p.borrow_mut() = ports);
             self.labels.set(labels);
             self.selected.set(selected.map(|i| i as u64));
         }
@@ -247,7 +251,6 @@ mod wasm {
         let supported = webserial::serial().is_some();
         let chooser = Chooser {
             console,
-            ports: StoredValue::new_local(Vec::new()),
             labels: crate::views::widgets::signal(Vec::new()),
             selected: crate::views::widgets::signal(None),
             baud: crate::views::widgets::signal(
