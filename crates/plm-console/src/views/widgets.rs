@@ -180,6 +180,8 @@ pub fn signal<T: Send + Sync + 'static>(value: T) -> RwSignal<T> {
 /// is laid out as the parent's own children). One render effect's code
 /// for every such part of the page, each only a boxed closure.
 #[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
 pub fn html(html: Box<dyn Fn() -> String + Send + Sync>) -> AnyView {
     view! { <span style="display: contents" inner_html=move || html()></span> }.into_any()
 }
@@ -204,6 +206,8 @@ pub fn option_html(html: &mut String, value: &str, label: &str, selected: bool) 
 /// A `<select>` whose options are the HTML of `options()` (see
 /// [`option_html`]), redrawn as it changes; `on` gets the value chosen.
 #[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
 pub fn select(
     id: &'static str,
     options: Box<dyn Fn() -> String + Send + Sync>,
@@ -217,6 +221,8 @@ pub fn select(
 
 /// A button whose label and `disabled` follow `label()` and `disabled()`.
 #[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
 pub fn live_button(
     id: &'static str,
     label: Box<dyn Fn() -> String + Send + Sync>,
@@ -233,6 +239,8 @@ pub fn live_button(
 
 /// A checkbox checked as `checked()` says; `on` gets its new state.
 #[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
 pub fn checkbox(
     id: &'static str,
     checked: Box<dyn Fn() -> bool + Send + Sync>,
