@@ -2,7 +2,9 @@
 //! the host's ACK latency, firmware version, reset with the last reset
 //! cause, and the counters of MIB 06h-08h with erase.
 
-use super::widgets::{action_button, button, escape, note, on_click, on_event, text_input};
+use super::widgets::{
+    action_button, button, checkbox, escape, html, note, on_click, text, text_input,
+};
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
 use crate::stores::{refusal, use_console};
@@ -48,12 +50,18 @@ pub(crate) fn fields_html(layout: &'static [Field], data: &[u8]) -> String {
         })
 }
 
-/// Named values of `data` under `layout` as a table (`id` may be empty),
-/// written as HTML in one go (as `widgets::text_table`).
-pub(crate) fn field_table(id: &'static str, layout: &'static [Field], data: &[u8]) -> AnyView {
-    let html = fields_html(layout, data);
-    view! { <table class="kv" id=(!id.is_empty()).then_some(id) inner_html=html></table> }
-        .into_any()
+/// Named values of `data` under `layout` as the HTML of a table (`id`
+/// may be empty).
+fn table_html(id: &str, layout: &'static [Field], data: &[u8]) -> String {
+    let id = if id.is_empty() {
+        String::new()
+    } else {
+        format!(" id=\"{id}\"")
+    };
+    format!(
+        "<table class=\"kv\"{id}>{}</table>",
+        fields_html(layout, data)
+    )
 }
 
 #[component]
@@ -69,7 +77,8 @@ fn PingCard() -> impl IntoView {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));
     };
-    let history = crate::views::widgets::signal(Vec::<u64>::new());
+    // The last round trips, as written (a signal type the page has).
+    let history = crate::views::widgets::signal(Vec::<String>::new());
     let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
@@ -94,7 +103,7 @@ fn PingCard() -> impl IntoView {
                     rtt,
                 } => {
                     history.update(|h| {
-                        h.push(rtt);
+                        h.push(millis(rtt));
                         if h.len() > 10 {
                             h.remove(0);
                         }
@@ -126,19 +135,20 @@ fn PingCard() -> impl IntoView {
                 {text_input("ping-payload", "hex", "", Some(30), payload)}
             </label>
             {button("ping-send", "Ping", "", ping)}
-            <p id="ping-result" class:problem=move || problem.get()>
-                {move || result.get()}
-            </p>
-            <p class="muted" id="ping-history">
-                {move || {
-                    let h = history.get();
-                    (!h.is_empty())
-                        .then(|| {
-                            let list: Vec<String> = h.iter().map(|r| millis(*r)).collect();
-                            format!("Last round trips: {}", list.join(", "))
-                        })
-                }}
-            </p>
+            {html(Box::new(move || {
+                let history = history.with(|h| {
+                    if h.is_empty() {
+                        String::new()
+                    } else {
+                        format!("Last round trips: {}", h.join(", "))
+                    }
+                });
+                format!(
+                    "<p id=\"ping-result\"{}>{}</p><p class=\"muted\" id=\"ping-history\">{history}</p>",
+                    if problem.get() { " class=\"problem\"" } else { "" },
+                    escape(&result.get().unwrap_or_default())
+                )
+            }))}
         </article>
     }
 }
@@ -146,12 +156,13 @@ fn PingCard() -> impl IntoView {
 #[component]
 fn StatusCard() -> impl IntoView {
     let c = use_console();
-    let byte = Memo::new(move |_| c.modem.status.get().map(|(_, b)| b));
-    let received = move || {
-        c.modem
-            .status
-            .get()
-            .map(|(at, b)| format!("3F {b:02X}, received at {}", seconds(at)))
+    let html_of = move || match c.modem.status.get() {
+        None => "<p class=\"muted\">No status message yet: send any request.</p>".to_string(),
+        Some((at, b)) => format!(
+            "<p>3F {b:02X}, received at {}</p>{}",
+            seconds(at),
+            table_html("", status::LAYOUT, &[b])
+        ),
     };
     view! {
         <article class="card" id="status">
@@ -159,16 +170,7 @@ fn StatusCard() -> impl IntoView {
             <p class="muted">
                 "The bits of the last status message (UM0932 Table 8); the modem sends one each time the host asks to send."
             </p>
-            // The table is drawn again only when the byte changes; the
-            // time of the last one is a text (one status per exchange).
-            {move || match byte.get() {
-                None => view! { <p class="muted">"No status message yet: send any request."</p> }.into_any(),
-                Some(byte) => view! {
-                    <p>{received}</p>
-                    {field_table("", status::LAYOUT, &[byte])}
-                }
-                .into_any(),
-            }}
+            {html(Box::new(html_of))}
         </article>
     }
 }
@@ -177,43 +179,42 @@ fn StatusCard() -> impl IntoView {
 #[component]
 fn AckLatencyCard() -> impl IntoView {
     let c = use_console();
-    // Recomputed when traffic comes: every ACK goes to the traffic log.
-    let latency = Memo::new(move |_| {
+    // Written again when traffic comes: every ACK goes to the traffic log.
+    let html_of = move || {
         c.traffic.log.track();
         c.conn.port.track();
-        c.ack_latency()
-    });
-    let simulated = move || c.conn.kind.get() == "Simulated";
-    let none = Memo::new(move |_| latency.with(|l| l.count == 0));
-    let t_ack = move || c.conn.timeouts.get().t_ack;
-    let line = move || {
-        let p = latency.with(|l| l.page);
+        let l = c.ack_latency();
+        if l.count == 0 {
+            return "<p class=\"muted\" id=\"ack-latency-value\">No frame from the modem yet.</p>"
+                .to_string();
+        }
+        let t_ack = c.conn.timeouts.get().t_ack;
+        let p = l.page;
+        let frames = if l.count as usize > ACK_SAMPLES {
+            format!(
+                "Over the last {ACK_SAMPLES} of {} frames ACKed since connecting.",
+                l.count
+            )
+        } else {
+            format!("{} frame(s) ACKed since connecting.", l.count)
+        };
+        let link = if c.conn.kind.get() == "Simulated" {
+            format!(
+                "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
+                millis(l.link.p99),
+                millis(l.link.max)
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)",
+            "<p id=\"ack-latency-value\"{}>ACK latency p50 {}, p99 {}, max {} (T_ACK {} ms)</p><p class=\"muted\">{frames} {link}</p>",
+            if p.max > t_ack { " class=\"problem\"" } else { "" },
             millis(p.p50),
             millis(p.p99),
             millis(p.max),
-            t_ack() / MS
+            t_ack / MS
         )
-    };
-    let late = move || latency.with(|l| l.page.max) > t_ack();
-    let frames = move || {
-        let count = latency.with(|l| l.count);
-        if count as usize > ACK_SAMPLES {
-            format!("Over the last {ACK_SAMPLES} of {count} frames ACKed since connecting.")
-        } else {
-            format!("{count} frame(s) ACKed since connecting.")
-        }
-    };
-    let link = move || {
-        let l = latency.with(|l| l.link);
-        simulated().then(|| {
-            format!(
-                "The simulated modem's virtual time waits for the page, so it saw p99 {} (max {}).",
-                millis(l.p99),
-                millis(l.max)
-            )
-        })
     };
     view! {
         <article class="card" id="ack-latency">
@@ -221,22 +222,7 @@ fn AckLatencyCard() -> impl IntoView {
             <p class="muted">
                 "From the last byte of each modem frame to the host's ACK (UM0932 3.2.8), on the page's clock: it includes how late the page woke and any stall of the page."
             </p>
-            // Only the texts change as traffic comes (a redraw of the
-            // card's elements at every hand-out would hold up the next ACK
-            // longer, issue 13).
-            {move || {
-                if none.get() {
-                    return view! { <p class="muted" id="ack-latency-value">"No frame from the modem yet."</p> }
-                        .into_any();
-                }
-                view! {
-                    <p id="ack-latency-value" class:problem=late>
-                        {line}
-                    </p>
-                    <p class="muted">{frames} " " {link}</p>
-                }
-                .into_any()
-            }}
+            {html(Box::new(html_of))}
         </article>
     }
 }
@@ -259,7 +245,7 @@ fn FirmwareCard() -> impl IntoView {
                 c.read_mib(index::FIRMWARE_VERSION as u16, move |r| message.set(r.err()));
             })}
             <p id="firmware-value" class="big">
-                {move || value().map(|v| format!("{}h", plm_core::hex::encode(&v).to_ascii_uppercase()))}
+                {text(Box::new(move || value().map_or(String::new(), |v| format!("{}h", plm_core::hex::encode(&v).to_ascii_uppercase()))))}
             </p>
             {note("", "problem", message)}
         </article>
@@ -297,12 +283,7 @@ fn ResetCard() -> impl IntoView {
             <label
                 title="DTR drives the modem's RESETN on this port (kept per port): DTR is kept released"
             >
-                <input
-                    type="checkbox"
-                    id="resetn-on-dtr"
-                    prop:checked=move || c.conn.resetn_on_dtr.get()
-                    on:change=on_event(move |ev| c.set_resetn_on_dtr(event_target_checked(&ev)))
-                />
+                {checkbox("resetn-on-dtr", Box::new(move || c.conn.resetn_on_dtr.get()), Box::new(move |on| c.set_resetn_on_dtr(on)))}
                 " RESETN wired to DTR"
             </label>
             <button
@@ -318,14 +299,14 @@ fn ResetCard() -> impl IntoView {
             </button>
             {note("reset-result", "", message)}
             <h4>"Last BIO_ResetIndication"</h4>
-            {move || match c.modem.last_reset.get() {
-                None => view! { <p class="muted">"None since connecting."</p> }.into_any(),
-                Some((at, byte)) => view! {
-                    <p>{format!("ResetData {byte:02X}h at {}", seconds(at))}</p>
-                    {field_table("reset-cause", reset_data::LAYOUT, &[byte])}
-                }
-                .into_any(),
-            }}
+            {html(Box::new(move || match c.modem.last_reset.get() {
+                None => "<p class=\"muted\">None since connecting.</p>".to_string(),
+                Some((at, byte)) => format!(
+                    "<p>ResetData {byte:02X}h at {}</p>{}",
+                    seconds(at),
+                    table_html("reset-cause", reset_data::LAYOUT, &[byte])
+                ),
+            }))}
         </article>
     }
 }
@@ -369,10 +350,10 @@ fn Counters(index: u8) -> impl IntoView {
             <h4>{format!("{index:02X}h {}", o.name)}</h4>
             {action_button("read", "Read", read)}
             {action_button("erase", "Erase", erase)}
-            {move || match value() {
-                None => view! { <p class="muted">"Not read yet."</p> }.into_any(),
-                Some(v) => field_table("", o.fields, &v),
-            }}
+            {html(Box::new(move || match value() {
+                None => "<p class=\"muted\">Not read yet.</p>".to_string(),
+                Some(v) => table_html("", o.fields, &v),
+            }))}
             {note("", "problem", message)}
         </div>
     }

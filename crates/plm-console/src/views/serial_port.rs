@@ -35,7 +35,9 @@ mod wasm {
     use crate::stores::{use_console, Console};
     use crate::transport::webserial::{self, OnLost, Settings, TReqPolarity, WebSerialTransport};
     use crate::transport::LinkState;
-    use crate::views::widgets::{on_click, on_event};
+    use crate::views::widgets::{
+        checkbox, escape, html, live_button, on_click, option_html, select, text,
+    };
     use leptos::prelude::*;
     use plm_sim::BAUD_RATES;
     use std::rc::Rc;
@@ -56,17 +58,23 @@ mod wasm {
         crate::storage::store(key, Some(value));
     }
 
+    thread_local! {
+        /// Granted ports, in the order `getPorts` gave them (one chooser
+        /// in the page, which lives as long as it).
+        static PORTS: std::cell::RefCell<Vec<Port>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+
     /// The panel's state; `Copy`, shared by the handlers.
     #[derive(Clone, Copy)]
     struct Chooser {
         console: Console,
-        /// Granted ports, in the order `getPorts` gave them.
-        ports: StoredValue<Vec<Port>, LocalStorage>,
         /// Their names, for the list.
         labels: RwSignal<Vec<String>>,
-        selected: RwSignal<Option<usize>>,
+        /// The index of the chosen port (a signal type the page has anyway).
+        selected: RwSignal<Option<u64>>,
         baud: RwSignal<u32>,
-        polarity: RwSignal<TReqPolarity>,
+        /// The key of the [`TReqPolarity`] chosen.
+        polarity: RwSignal<String>,
         /// Each RTS change sent twice (Windows' usbser driver).
         rts_twice: RwSignal<bool>,
         /// A port is being opened.
@@ -76,13 +84,16 @@ mod wasm {
     }
 
     impl Chooser {
+        /// The chosen port.
+        fn port(&self) -> Option<Port> {
+            let i = self.selected.get_untracked()? as usize;
+            PORTS.with(|p| p.borrow().get(i).cloned())
+        }
+
         /// Shows `ports`, keeping the selection on the same port, else on
         /// the one used last time, else the first.
         fn show(&self, ports: Vec<Port>, prefer: Option<Port>) {
-            let current = self
-                .selected
-                .get_untracked()
-                .and_then(|i| self.ports.with_value(|p| p.get(i).cloned()));
+            let current = self.port();
             let labels: Vec<String> = ports.iter().map(webserial::describe).collect();
             let last = load(KEY_PORT);
             let same = |want: &Port| {
@@ -96,9 +107,9 @@ mod wasm {
                 .or_else(|| current.as_ref().and_then(same))
                 .or_else(|| last.and_then(|l| labels.iter().position(|x| *x == l)))
                 .or(if ports.is_empty() { None } else { Some(0) });
-            self.ports.set_value(ports);
+            PORTS.with(|p| *p.borrow_mut() = ports);
             self.labels.set(labels);
-            self.selected.set(selected);
+            self.selected.set(selected.map(|i| i as u64));
         }
 
         /// Asks the browser for the ports granted to this site.
@@ -150,11 +161,7 @@ mod wasm {
 
         /// Opens the selected port and makes it the session's transport.
         fn connect(self) {
-            let Some(port) = self
-                .selected
-                .get_untracked()
-                .and_then(|i| self.ports.with_value(|p| p.get(i).cloned()))
-            else {
+            let Some(port) = self.port() else {
                 self.message.set(Some(
                     "no port: choose one first (Choose a port…)".to_string(),
                 ));
@@ -163,7 +170,8 @@ mod wasm {
             let label = webserial::describe(&port);
             let settings = Settings {
                 baud: self.baud.get_untracked(),
-                polarity: self.polarity.get_untracked(),
+                polarity: TReqPolarity::from_key(&self.polarity.get_untracked())
+                    .unwrap_or_default(),
                 rts_twice: self.rts_twice.get_untracked(),
             };
             save(KEY_BAUD, &settings.baud.to_string());
@@ -244,7 +252,6 @@ mod wasm {
         let supported = webserial::serial().is_some();
         let chooser = Chooser {
             console,
-            ports: StoredValue::new_local(Vec::new()),
             labels: crate::views::widgets::signal(Vec::new()),
             selected: crate::views::widgets::signal(None),
             baud: crate::views::widgets::signal(
@@ -255,8 +262,8 @@ mod wasm {
             ),
             polarity: crate::views::widgets::signal(
                 load(KEY_POLARITY)
-                    .and_then(|p| TReqPolarity::from_key(&p))
-                    .unwrap_or_default(),
+                    .filter(|p| TReqPolarity::from_key(p).is_some())
+                    .unwrap_or_else(|| TReqPolarity::default().key().to_string()),
             ),
             rts_twice: crate::views::widgets::signal(load(KEY_RTS_TWICE).is_some()),
             busy: crate::views::widgets::signal(false),
@@ -291,45 +298,33 @@ mod wasm {
 
         let ports = move || {
             let list = labels.get();
+            let mut h = String::new();
             if list.is_empty() {
-                return view! { <option value="" selected>"no port granted yet"</option> }
-                    .into_any();
+                option_html(&mut h, "", "no port granted yet", true);
             }
-            list.into_iter()
-                .enumerate()
-                .map(|(i, l)| {
-                    view! {
-                        <option value=i.to_string() selected=move || selected.get() == Some(i)>
-                            {l}
-                        </option>
-                    }
-                })
-                .map(IntoAny::into_any)
-                .collect_view()
-                .into_any()
+            let chosen = selected.get();
+            for (i, l) in list.iter().enumerate() {
+                option_html(&mut h, &i.to_string(), l, chosen == Some(i as u64));
+            }
+            h
         };
-        let bauds = BAUD_RATES
-            .iter()
-            .map(|&b| {
-                view! {
-                    <option value=b.to_string() selected=move || baud.get() == b>
-                        {b.to_string()}
-                    </option>
-                }
-            })
-            .map(IntoAny::into_any)
-            .collect_view();
-        let polarities = TReqPolarity::ALL
-            .into_iter()
-            .map(|p| {
-                view! {
-                    <option value=p.key() selected=move || polarity.get() == p>
-                        {p.label()}
-                    </option>
-                }
-            })
-            .map(IntoAny::into_any)
-            .collect_view();
+        let bauds = move || {
+            let chosen = baud.get();
+            let mut h = String::new();
+            for b in BAUD_RATES {
+                option_html(&mut h, &b.to_string(), &b.to_string(), b == chosen);
+            }
+            h
+        };
+        let polarities = move || {
+            let chosen = polarity.get();
+            let chosen = chosen.as_str();
+            let mut h = String::new();
+            for p in TReqPolarity::ALL {
+                option_html(&mut h, p.key(), p.label(), p.key() == chosen);
+            }
+            h
+        };
         let controls = if supported {
             view! {
                 <p class="muted" style="margin-top: 0">
@@ -338,13 +333,7 @@ mod wasm {
                 <div style="display: grid; grid-template-columns: max-content 1fr; gap: 6px 10px; align-items: center">
                     <label for="serial-port">"Port"</label>
                     <span style="display: flex; gap: 6px">
-                        <select
-                            id="serial-port"
-                            style="flex: 1"
-                            on:change=on_event(move |ev| selected.set(event_target_value(&ev).parse().ok()))
-                        >
-                            {ports}
-                        </select>
+                        {select("serial-port", Box::new(ports), Box::new(move |v| selected.set(v.parse().ok())))}
                         {button("serial-choose", "Choose a port…", "The browser asks which port this site may use, and remembers the answer.", move || chooser.choose())}
                     </span>
                     <label
@@ -353,42 +342,27 @@ mod wasm {
                     >
                         "Baud"
                     </label>
-                    <select
-                        id="serial-baud"
-                        on:change=on_event(move |ev| {
-                            if let Ok(b) = event_target_value(&ev).parse() {
-                                baud.set(b);
-                            }
-                        })
-                    >
-                        {bauds}
-                    </select>
+                    {select("serial-baud", Box::new(bauds), Box::new(move |v| {
+                        if let Ok(b) = v.parse() {
+                            baud.set(b);
+                        }
+                    }))}
                     <label
                         for="serial-polarity"
                         title="Which RTS level pulls T_REQ low (a request to send). Straight wiring: RTS asserted = T_REQ low; through an inverting level shifter: the other."
                     >
                         "T_REQ"
                     </label>
-                    <select
-                        id="serial-polarity"
-                        on:change=on_event(move |ev| {
-                            if let Some(p) = TReqPolarity::from_key(&event_target_value(&ev)) {
-                                polarity.set(p);
-                            }
-                        })
-                    >
-                        {polarities}
-                    </select>
+                    {select("serial-polarity", Box::new(polarities), Box::new(move |v| {
+                        if TReqPolarity::from_key(&v).is_some() {
+                            polarity.set(v);
+                        }
+                    }))}
                     <span></span>
                     <label
                         title="Windows' usbser driver sets RTS one call late"
                     >
-                        <input
-                            type="checkbox"
-                            id="serial-rts-twice"
-                            prop:checked=move || rts_twice.get()
-                            on:change=on_event(move |ev| rts_twice.set(event_target_checked(&ev)))
-                        />
+                        {checkbox("serial-rts-twice", Box::new(move || rts_twice.get()), Box::new(move |on| rts_twice.set(on)))}
                         " Send each RTS change twice (Windows)"
                     </label>
                 </div>
@@ -408,7 +382,7 @@ mod wasm {
                     title=if supported { "Connect to a real modem over WebSerial" } else { NO_WEB_SERIAL }
                     on:click=on_click(move |_| open.update(|o| *o = !*o))
                 >
-                    {summary}
+                    {text(Box::new(move || summary().to_string()))}
                 </button>
                 <div
                     id="serial-panel"
@@ -421,29 +395,24 @@ mod wasm {
                 >
                     {controls}
                     <div class="buttons" style="margin-top: 10px">
-                        {move || (supported).then(|| view! {
-                            <button
-                                id="serial-connect"
-                                disabled=move || busy.get() || labels.with(Vec::is_empty)
-                                on:click=on_click(move |_| chooser.connect())
-                            >
-                                {move || String::from(if active() { "Reconnect" } else { "Connect over WebSerial" })}
-                            </button>
-                        }).map(IntoAny::into_any)}
-                        <button
-                            id="serial-use-sim"
-                            disabled=move || console.conn.kind.get() == "Simulated"
-                            on:click=on_click(move |_| chooser.use_simulator())
-                        >
-                            "Use the simulated modem"
-                        </button>
+                        {supported.then(|| live_button(
+                            "serial-connect",
+                            Box::new(move || String::from(if active() { "Reconnect" } else { "Connect over WebSerial" })),
+                            Box::new(move || busy.get() || labels.with(Vec::is_empty)),
+                            Box::new(move || chooser.connect()),
+                        ))}
+                        {live_button(
+                            "serial-use-sim",
+                            Box::new(|| String::from("Use the simulated modem")),
+                            Box::new(move || console.conn.kind.get() == "Simulated"),
+                            Box::new(move || chooser.use_simulator()),
+                        )}
                         {button("serial-close", "Close", "", move || open.set(false))}
                     </div>
-                    {move || (message.with(Option::is_some)).then(|| view! {
-                        <p class="message" id="serial-message" role="status">
-                            {move || message.get().unwrap_or_default()}
-                        </p>
-                    }).map(IntoAny::into_any)}
+                    {html(Box::new(move || message.with(|m| m.as_deref().map_or(String::new(), |m| format!(
+                        "<p class=\"message\" id=\"serial-message\" role=\"status\">{}</p>",
+                        escape(m)
+                    )))))}
                 </div>
             </span>
         }

@@ -185,3 +185,85 @@ pub fn set_value(value: RwSignal<String>) -> Box<dyn FnMut(web_sys::Event)> {
 pub fn set_checked(value: RwSignal<bool>) -> Box<dyn FnMut(web_sys::Event)> {
     Box::new(move |ev| value.set(event_target_checked(&ev)))
 }
+
+/// HTML from `html()`, redrawn whenever what it reads changes, in a
+/// `<span style="display: contents">` (no box of its own: what it holds
+/// is laid out as the parent's own children). One render effect's code
+/// for every such part of the page, each only a boxed closure.
+#[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
+pub fn html(html: Box<dyn Fn() -> String + Send + Sync>) -> AnyView {
+    view! { <span style="display: contents" inner_html=move || html()></span> }.into_any()
+}
+
+/// A text redrawn from `text()` (as [`html`], one render effect's code
+/// for all).
+#[inline(never)]
+pub fn text(text: Box<dyn Fn() -> String + Send + Sync>) -> AnyView {
+    (move || text()).into_any()
+}
+
+/// An `<option>` as HTML, appended to `html`.
+pub fn option_html(html: &mut String, value: &str, label: &str, selected: bool) {
+    html.push_str(&format!(
+        "<option value=\"{}\"{}>{}</option>",
+        escape(value),
+        if selected { " selected" } else { "" },
+        escape(label)
+    ));
+}
+
+/// A `<select>` whose options are the HTML of `options()` (see
+/// [`option_html`]), redrawn as it changes; `on` gets the value chosen.
+#[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
+pub fn select(
+    id: &'static str,
+    options: Box<dyn Fn() -> String + Send + Sync>,
+    on: Box<dyn Fn(String)>,
+) -> AnyView {
+    view! {
+        <select id=id inner_html=move || options() on:change=on_event(move |ev| on(event_target_value(&ev)))></select>
+    }
+    .into_any()
+}
+
+/// A button whose label and `disabled` follow `label()` and `disabled()`.
+#[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
+pub fn live_button(
+    id: &'static str,
+    label: Box<dyn Fn() -> String + Send + Sync>,
+    disabled: Box<dyn Fn() -> bool + Send + Sync>,
+    on: Box<dyn Fn()>,
+) -> AnyView {
+    view! {
+        <button id=id disabled=move || disabled() on:click=on_click(move |_| on())>
+            {move || label()}
+        </button>
+    }
+    .into_any()
+}
+
+/// A checkbox checked as `checked()` says; `on` gets its new state.
+#[inline(never)]
+// The closure, not the box: the bindings' code is instantiated for it.
+#[allow(clippy::redundant_closure)]
+pub fn checkbox(
+    id: &'static str,
+    checked: Box<dyn Fn() -> bool + Send + Sync>,
+    on: Box<dyn Fn(bool)>,
+) -> AnyView {
+    view! {
+        <input
+            type="checkbox"
+            id=id
+            prop:checked=move || checked()
+            on:change=on_event(move |ev| on(event_target_checked(&ev)))
+        />
+    }
+    .into_any()
+}
