@@ -34,6 +34,7 @@ test('the ST7570 is chosen in the connection bar, remembered, and configured as 
   const page = await open(t);
   await page.selectOption('#profile', 'st7570');
   await page.locator('#conn-chip', { hasText: 'ST7570' }).waitFor();
+  await page.locator('#conn-transport', { hasText: 'simulated S-FSK network' }).waitFor();
   await page.locator('#conn-port', { hasText: 'ST7570 (simulated, 3 Servers on the line)' }).waitFor();
   // Every ST7570 object, from the declarative MIB (Table 71).
   await page.locator('#mib-00a1').waitFor();

@@ -28,11 +28,12 @@ pub fn ConnectionBar() -> impl IntoView {
             LinkState::Disconnected(why) => (false, why),
         };
         let kind = conn.kind.get();
-        let transport = match kind.as_str() {
-            "" => "none",
-            "Simulated" if modem() => "simulated modem",
-            "Simulated" => "simulated street",
-            other => other,
+        let transport = match (kind.as_str(), profile.get()) {
+            ("", _) => "none",
+            ("Simulated", Profile::St7570) => "simulated S-FSK network",
+            ("Simulated", p) if !p.is_street() => "simulated modem",
+            ("Simulated", _) => "simulated street",
+            (other, _) => other,
         };
         format!(
             "<span id=\"conn-state\" class=\"state{}\" title=\"{}\">{}</span>\

@@ -4,7 +4,7 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
-use super::widgets::{button, on_click, on_event, text_input};
+use super::widgets::{button, checkbox, live_button, on_click, on_event, text_input};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -186,15 +186,11 @@ fn SweepControl() -> impl IntoView {
     let street = use_console().street;
     view! {
         <label title="reads every lamp in turn, one request at a time, as fast as the line carries">
-            <input
-                type="checkbox"
-                id="street-sweep"
-                prop:checked=move || street.sweep.get().on
-                on:change=on_event(move |ev| {
-                    let on = event_target_checked(&ev);
-                    street.act(|s| s.set_sweep(on));
-                })
-            />
+            {checkbox(
+                "street-sweep",
+                Box::new(move || street.sweep.get().on),
+                Box::new(move |on| street.act(|s| s.set_sweep(on))),
+            )}
             " Poll the street"
         </label>
         <span id="street-progress" class="muted">
@@ -278,19 +274,19 @@ fn GroupActions(
                 "Dimming % "
                 {text_input("street-dim-level", "", "", Some(4), level)}
             </label>
-            <button
-                id="street-dim-selected"
-                prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=on_click(move |_| dim(Some(selected.get_untracked())))
-            >
-                {move || format!("Dim selected ({})", selected.with(|s| s.len()))}
-            </button>
+            {live_button(
+                "street-dim-selected",
+                Box::new(move || format!("Dim selected ({})", selected.with(|s| s.len()))),
+                Box::new(move || selected.with(|s| s.is_empty())),
+                Box::new(move || dim(Some(selected.get_untracked()))),
+            )}
             {button("street-dim-all", "Dim all (broadcast)", "", move || dim(None))}
             {button("street-clock-all", "Set all clocks from this computer", "sets every lamp's clock to this computer's local time", set_clocks)}
-            <button
-                id="street-clock-selected"
-                prop:disabled=move || selected.with(|s| s.is_empty())
-                on:click=on_click(move |_| {
+            {live_button(
+                "street-clock-selected",
+                Box::new(|| "Set clocks of selected".to_string()),
+                Box::new(move || selected.with(|s| s.is_empty())),
+                Box::new(move || {
                     let c = computer_clock();
                     let list = selected.get_untracked();
                     let r = street.act(|s| {
@@ -302,10 +298,8 @@ fn GroupActions(
                         Ok(()) => format!("clock {c} sent to {} lamp(s)", list.len()),
                         Err(e) => format!("nothing sent: {e}"),
                     }));
-                })
-            >
-                "Set clocks of selected"
-            </button>
+                }),
+            )}
         </div>
     }
 }

@@ -7,7 +7,9 @@
 //! from what the browser kept; the results export as CSV.
 
 use super::files::{chosen_file, download, download_bytes, read_bytes};
-use super::widgets::{button, escape, note, on_click, on_event, text_input};
+use super::widgets::{
+    button, escape, live_button, note, on_event, option_html, select, text_input,
+};
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
 use leptos::prelude::*;
@@ -182,17 +184,18 @@ pub fn UpdateView() -> impl IntoView {
             <div class="toolbar">
                 <label>
                     "Lamps "
-                    <select id="update-targets" on:change=on_event(move |ev| choice.set(event_target_value(&ev)))>
-                        {move || target_options(street, choice)}
-                    </select>
+                    {select(
+                        "update-targets",
+                        Box::new(move || target_options(street, choice)),
+                        Box::new(move |v| choice.set(v)),
+                    )}
                 </label>
-                <button
-                    id="update-start"
-                    prop:disabled=move || running() == Some(true) || !chosen.with(|c| matches!(c, Some(Chosen { check: Ok(_), .. })))
-                    on:click=on_click(move |_| start())
-                >
-                    "Start update"
-                </button>
+                {live_button(
+                    "update-start",
+                    Box::new(|| "Start update".to_string()),
+                    Box::new(move || running() == Some(true) || !chosen.with(|c| matches!(c, Some(Chosen { check: Ok(_), .. })))),
+                    Box::new(start),
+                )}
             </div>
             {move || message.with(|m| m.is_some()).then(|| note("update-message", "message", message))}
             <Progress/>
@@ -200,9 +203,10 @@ pub fn UpdateView() -> impl IntoView {
     }
 }
 
-/// The target list: all, the selection, each release, each lamp. Rebuilt
-/// when the fleet changes, with the choice made kept selected.
-fn target_options(street: StreetStore, choice: RwSignal<String>) -> impl IntoView {
+/// The target list as HTML options: all, the selection, each release,
+/// each lamp. Rebuilt when the fleet changes, with the choice made kept
+/// selected.
+fn target_options(street: StreetStore, choice: RwSignal<String>) -> String {
     street.version.track();
     let selected = street.selected.with(|s| s.len());
     // Each release with its count, in the order first met (a street has
@@ -239,14 +243,11 @@ fn target_options(street: StreetStore, choice: RwSignal<String>) -> impl IntoVie
         options.push((format!("lamp:{a}"), format!("lamp {a} (release {r})")));
     }
     let current = choice.get_untracked();
-    options
-        .into_iter()
-        .map(|(value, label)| {
-            let selected = value == current;
-            view! { <option value=value selected=selected>{label}</option> }
-        })
-        .map(IntoAny::into_any)
-        .collect_view()
+    let mut html = String::new();
+    for (value, label) in options {
+        option_html(&mut html, &value, &label, value == current);
+    }
+    html
 }
 
 /// One board's line: address, state, its segments held, the result.
