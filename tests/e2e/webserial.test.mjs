@@ -469,8 +469,9 @@ test('WebSerial: the traffic log exports to JSON Lines and imports again', async
   assert.ok(entries.some((e) => e.command === 'PingConfirm' && e.from === 'modem'));
 });
 
-test('WebSerial: an ST7570 on the port (plm sim --chip st7570) is made a MAC Client, a Server answers its frame, and a wrong f0 is refused', async (t) => {
-  const { page, wire } = await open(t, { world: ['--chip', 'st7570', '--nodes', '4'], profile: 'st7570' });
+test('WebSerial: an ST7570 on the port (plm sim --chip st7570) is made a MAC Client, a Server answers its frame, alarms go both ways, and a wrong f0 is refused', async (t) => {
+  // --alarms 2: the Servers raise an alarm in turn every 2 s.
+  const { page, wire } = await open(t, { world: ['--chip', 'st7570', '--nodes', '4', '--alarms', '2'], profile: 'st7570' });
   // The ST7570 sends no frame at power-on (its status message says RESET).
   await connectSerial(page, { reset: false });
   assert.match(await page.textContent('#conn-chip'), /ST7570/);
@@ -481,6 +482,10 @@ test('WebSerial: an ST7570 on the port (plm sim --chip st7570) is made a MAC Cli
   await page.locator('#net-nodes-table tr[data-key="001h"]').waitFor();
   // No simulated line in the page: a real network shows what the modem hears.
   assert.equal(await page.locator('#net-sim').isVisible(), false);
+  // A Server's alarm comes in; the Client's own goes out.
+  await page.locator('#net-alarm-history', { hasText: 'alarm received' }).waitFor({ timeout: 20_000 });
+  await page.click('#net-alarm');
+  await page.locator('#net-alarm-history', { hasText: 'alarm sent: LP_OK' }).waitFor({ timeout: 10_000 });
   assert.ok(wireLog(wire).some((e) => e.rts === true), 'T_REQ driven by RTS');
   await shot(page, 'webserial-st7570-network');
   await refusedFrequency(page, 'webserial-st7570-refused', ST7570_F);

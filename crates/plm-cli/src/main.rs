@@ -144,6 +144,12 @@ struct SimArgs {
     /// or a power cycle relights it (plm-sim's ballast model).
     #[arg(long, default_value_t = 0.0, value_parser = failure_rate, conflicts_with = "nodes")]
     lamp_failures: f64,
+    /// With --chip st7570: every SECONDS of simulated time the next MAC
+    /// Server in turn raises an alarm (its host sends CMD_AlarmRequest,
+    /// heard once it is synchronized), so that a host program sees
+    /// CMD_AlarmIndication come in (1-3600).
+    #[arg(long, value_name = "SECONDS", value_parser = clap::value_parser!(u16).range(1..=3600))]
+    alarms: Option<u16>,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -242,10 +248,24 @@ fn st7570_world(args: &SimArgs) -> Result<sim_server::World, String> {
              give --nodes {serve} or more"
         ));
     }
-    Ok(sim_server::World::St7570 { nodes, serve })
+    if args.alarms.is_some() && nodes == serve {
+        return Err(format!(
+            "--alarms: every node is served ({nodes}), no Server raises one; \
+             add Servers with --nodes {} or more",
+            serve + 1
+        ));
+    }
+    Ok(sim_server::World::St7570 {
+        nodes,
+        serve,
+        alarms: args.alarms.map(|s| u64::from(s) * 1_000_000),
+    })
 }
 
 fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
+    if args.alarms.is_some() {
+        return Err("--alarms needs --chip st7570: MAC Servers raise the alarms".into());
+    }
     let world = match (args.board, args.street) {
         (true, n) => sim_server::World::Street {
             lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),

@@ -37,6 +37,7 @@
 //! MIB and BIO_ResetIndication); a client that never touches DTR finds the
 //! modem running (the line starts released).
 
+pub mod alarms;
 pub mod event_loop;
 
 pub use event_loop::{Served, Stopper, RATES};
@@ -76,6 +77,9 @@ pub enum World {
         nodes: usize,
         /// Nodes 0..serve served, each on its own port.
         serve: usize,
+        /// Every this many µs the next Server raises an alarm
+        /// ([`alarms::Alarming`]); `None`: only when asked.
+        alarms: Option<u64>,
     },
     /// A street of lamps behind the served modem or concentrator board.
     Street {
@@ -137,12 +141,18 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         .map(|l| l.local_addr().map_err(|e| e.to_string()))
         .collect::<Result<_, _>>()?;
     let addr = addrs[0];
-    if let World::St7570 { nodes, serve } = opts.world {
+    if let World::St7570 {
+        nodes,
+        serve,
+        alarms,
+    } = opts.world
+    {
         return Ok(bind_st7570(
             addrs,
             listeners,
             nodes.max(serve),
             serve,
+            alarms,
             opts.seed,
         ));
     }
@@ -248,6 +258,7 @@ fn bind_st7570(
     listeners: Vec<TcpListener>,
     nodes: usize,
     serve: usize,
+    alarms: Option<u64>,
     seed: u64,
 ) -> Bound {
     use plm_sim::st7570::net::{NetConfig, Network};
@@ -304,16 +315,27 @@ fn bind_st7570(
             )
         });
     }
+    if let Some(every) = alarms {
+        banner.push(format!(
+            "plm sim: every {} s a Server raises an alarm (nodes {serve}-{} in turn)",
+            every / 1_000_000,
+            nodes - 1
+        ));
+    }
     banner.push(
         "plm sim: the simulation powers on when the first client connects; Ctrl-C stops".into(),
     );
     let signatures = (0..serve)
         .map(|node| format!("plm sim: simulated ST7570, node {node}"))
         .collect();
+    let world: Box<dyn plm_sim::Ports + Send> = match alarms {
+        Some(every) => Box::new(alarms::Alarming::new(net, every)),
+        None => Box::new(net),
+    };
     Bound {
         addrs,
         banner,
-        served: Served::new(Box::new(net), listeners, signatures),
+        served: Served::new(world, listeners, signatures),
     }
 }
 

@@ -171,3 +171,13 @@ fn street_and_echo_flags_are_refused_with_chip_st7570() {
         "{err}"
     );
 }
+
+#[test]
+fn alarms_need_st7570_servers() {
+    let err = refused(&["--alarms", "5"]);
+    assert!(err.contains("--alarms needs --chip st7570"), "{err}");
+    let err = refused(&["--chip", "st7570", "--nodes", "1", "--alarms", "5"]);
+    assert!(err.contains("no Server raises one"), "{err}");
+    let err = refused(&["--chip", "st7570", "--alarms", "0"]);
+    assert!(err.contains("--alarms"), "{err}");
+}

@@ -333,3 +333,48 @@ fn plm_sim_chip_st7570_through_rfc2217_and_the_host_engine() {
     drop(host);
     server.interrupt();
 }
+
+/// `--alarms 1`: the Servers raise an alarm in turn every second; once
+/// they are synchronized (the Client's frame to Server 1), the Client's
+/// host receives CMD_AlarmIndication (ST7570 UM 5.3.15).
+#[test]
+fn plm_sim_st7570_alarms_reach_the_client() {
+    let mut server = Server::start(&[
+        "--chip",
+        "st7570",
+        "--alarms",
+        "1",
+        "--listen",
+        "127.0.0.1:0",
+    ]);
+    let banner = server.lines_up_to("powers on when the first client connects");
+    let text = banner.join("\n");
+    assert!(
+        text.contains("every 1 s a Server raises an alarm (nodes 1-3 in turn)"),
+        "{text}"
+    );
+    let port = Client::open(&server.addr, BAUD).expect("an RFC 2217 port");
+    let mut host = Host::new(port);
+    host.write(index::PLC_CONFIGURATION, &mac_client());
+    host.layer = Layer::Mac;
+    let ask = MacData {
+        credit: Credit {
+            ic: 0,
+            cc: 0,
+            dc: 0,
+        },
+        address: Address { sa: 0, da: 1 },
+        pad: 0,
+        m_sdu: b"?".to_vec(),
+    };
+    match host.request(&Command::MacDataRequest(ask)) {
+        Command::DataConfirm { confirm_code } => assert_eq!(confirm_code, 0xFF, "LM_OK"),
+        other => panic!("{other:?}"),
+    }
+    host.frame("an alarm from a Server", |c| match c {
+        Command::AlarmIndication { .. } => Some(()),
+        _ => None,
+    });
+    drop(host);
+    server.interrupt();
+}
