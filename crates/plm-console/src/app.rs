@@ -13,6 +13,7 @@ use crate::views::simulator::SimulatorView;
 use crate::views::street::StreetView;
 use crate::views::traffic::TrafficView;
 use crate::views::update::UpdateView;
+use crate::views::widgets::signal;
 use leptos::prelude::*;
 
 /// The views, in the order of the tabs.
@@ -122,7 +123,7 @@ pub fn App() -> impl IntoView {
     crate::bench_hook::install(console);
     crate::wake::install(move || console.tick());
     crate::wake::soon();
-    let tab = crate::views::widgets::signal(Tab::from_hash(&current_hash()));
+    let tab = signal(Tab::from_hash(&current_hash()));
     let on_hash = window_event_listener(leptos::ev::hashchange, move |_| {
         tab.set(Tab::from_hash(&current_hash()));
     });

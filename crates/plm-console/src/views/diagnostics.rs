@@ -3,7 +3,7 @@
 //! cause, and the counters of MIB 06h-08h with erase.
 
 use super::widgets::{
-    action_button, button, checkbox, escape, html, note, on_click, text, text_input,
+    action_button, button, checkbox, escape, html, note, on_click, signal, text, text_input,
 };
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
@@ -67,18 +67,18 @@ fn table_html(id: &str, layout: &'static [Field], data: &[u8]) -> String {
 #[component]
 fn PingCard() -> impl IntoView {
     let c = use_console();
-    let payload = crate::views::widgets::signal(String::from("50 4c 4d 21"));
+    let payload = signal(String::from("50 4c 4d 21"));
     // What came of it, and whether that is a problem: two signals of types
     // the page has anyway rather than one `Option<Result<String, String>>`
     // (each signal type brings its own code, docs/console.md "Size").
-    let result = crate::views::widgets::signal(None::<String>);
-    let problem = crate::views::widgets::signal(false);
+    let result = signal(None::<String>);
+    let problem = signal(false);
     let show = move |r: Result<String, String>| {
         problem.set(r.is_err());
         result.set(Some(r.unwrap_or_else(|e| e)));
     };
     // The last round trips, as written (a signal type the page has).
-    let history = crate::views::widgets::signal(Vec::<String>::new());
+    let history = signal(Vec::<String>::new());
     let ping = move || {
         let data = match plm_core::hex::parse(&payload.get_untracked()) {
             Ok(d) if d.len() <= 255 => d,
@@ -230,7 +230,7 @@ fn AckLatencyCard() -> impl IntoView {
 #[component]
 fn FirmwareCard() -> impl IntoView {
     let c = use_console();
-    let message = crate::views::widgets::signal(None::<String>);
+    let message = signal(None::<String>);
     let value = move || {
         c.modem
             .mib
@@ -255,7 +255,7 @@ fn FirmwareCard() -> impl IntoView {
 #[component]
 fn ResetCard() -> impl IntoView {
     let c = use_console();
-    let message = crate::views::widgets::signal(None::<String>);
+    let message = signal(None::<String>);
     let reset = move || {
         message.set(Some("BIO_ResetRequest sent…".into()));
         c.request(Command::BioResetRequest, move |o| {
@@ -331,7 +331,7 @@ fn CountersCard() -> impl IntoView {
 fn Counters(index: u8) -> impl IntoView {
     let c = use_console();
     let o = object(index).expect("06h-08h are in Table 52");
-    let message = crate::views::widgets::signal(None::<String>);
+    let message = signal(None::<String>);
     let value = move || c.modem.mib.with(|m| m.get(&(index as u16)).cloned());
     let read = move || {
         c.read_mib(index as u16, move |r| message.set(r.err()));

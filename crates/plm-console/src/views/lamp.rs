@@ -3,7 +3,7 @@
 //! ballast reset, and on a simulated street the faults a demo needs.
 
 use super::street::{computer_clock, dimming_value};
-use super::widgets::{button, on_event, text_input};
+use super::widgets::{button, on_event, signal, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
 use leptos::prelude::*;
@@ -71,8 +71,8 @@ fn sparkline(points: &[(u64, f64)]) -> (String, String) {
 #[component]
 pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     let street = use_console().street;
-    let note = crate::views::widgets::signal(None::<String>);
-    let level = crate::views::widgets::signal(String::from("50"));
+    let note = signal(None::<String>);
+    let level = signal(String::from("50"));
     let lamp = Memo::new(move |_| {
         street.version.track();
         focus
@@ -80,10 +80,10 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
             .and_then(|a| street.with_fleet(|f| f.get(&a).cloned()))
     });
     // u32 signals (a type the page has) holding bytes.
-    let io_config = crate::views::widgets::signal(0u32);
-    let outputs = crate::views::widgets::signal(0u32);
-    let group = crate::views::widgets::signal(2u32);
-    let params = crate::views::widgets::signal(String::new());
+    let io_config = signal(0u32);
+    let outputs = signal(0u32);
+    let group = signal(2u32);
+    let params = signal(String::new());
     let ask = move |m: Message, what: &'static str| {
         let Some(a) = focus.get_untracked() else {
             return;

@@ -7,7 +7,7 @@
 //! the chip's own (`Console::read_mib` and friends).
 
 use super::files;
-use super::widgets::{button, escape, on_click, on_event};
+use super::widgets::{button, escape, on_click, on_event, signal};
 use crate::mibform;
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -29,7 +29,7 @@ fn inputs_of(object: &'static Object, data: &[u8]) -> Inputs {
 #[component]
 pub fn ModemView() -> impl IntoView {
     let c = use_console();
-    let progress = crate::views::widgets::signal(None::<String>);
+    let progress = signal(None::<String>);
     // The chip (ST7570 or not), its objects redrawn when it changes: a
     // memo of a type the page has anyway.
     let st7570 = Memo::new(move |_| c.profile.get().dialect() == Dialect::St7570);
@@ -44,8 +44,8 @@ pub fn ModemView() -> impl IntoView {
                 .collect()
         });
         let total = readable.len();
-        let done = crate::views::widgets::signal(0usize);
-        let failed = crate::views::widgets::signal(0usize);
+        let done = signal(0usize);
+        let failed = signal(0usize);
         progress.set(Some(format!("Reading 0 of {total}…")));
         for i in readable {
             c.read_mib(i, move |r| {
@@ -101,9 +101,9 @@ pub fn ModemView() -> impl IntoView {
 #[component]
 fn Profiles() -> impl IntoView {
     let c = use_console();
-    let message = crate::views::widgets::signal(None::<String>);
-    let running = crate::views::widgets::signal(false);
-    let cancel = crate::views::widgets::signal(false);
+    let message = signal(None::<String>);
+    let running = signal(false);
+    let cancel = signal(false);
     let save = move || {
         let values = c.modem.mib.get_untracked();
         let writable: Vec<u16> =
@@ -211,9 +211,9 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
     // The value last read, untracked: the effect below redraws the form
     // (through `inputs`) when it changes (no memo type of its own).
     let read_value = move || c.modem.mib.with_untracked(|m| m.get(&idx).cloned());
-    let inputs = crate::views::widgets::signal(inputs_of(object, object.default));
+    let inputs = signal(inputs_of(object, object.default));
     const NOT_READ: &str = "not read yet: the form shows the factory default";
-    let status = crate::views::widgets::signal(String::from(NOT_READ));
+    let status = signal(String::from(NOT_READ));
     Effect::new(move |last: Option<Option<Vec<u8>>>| {
         let value = c.modem.mib.with(|m| m.get(&idx).cloned());
         if last.as_ref() != Some(&value) {
@@ -234,8 +234,8 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
     });
     // Why the form was refused, by field name; the object's own reason
     // under "" (a signal of the inputs' type: no signal type of its own).
-    let problems = crate::views::widgets::signal(Inputs::default());
-    let reveal = crate::views::widgets::signal(false);
+    let problems = signal(Inputs::default());
+    let reveal = signal(false);
     let base = move || read_value().unwrap_or_else(|| object.default.to_vec());
 
     let read = move || {

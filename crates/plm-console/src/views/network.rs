@@ -5,7 +5,7 @@
 //! them. What it shows is [`crate::network::NetworkLog`]'s.
 
 use super::diagnostics::fields_html;
-use super::widgets::{button, escape, on_click, on_event, text_table};
+use super::widgets::{button, escape, on_click, on_event, signal, text_table};
 use super::{fixed, seconds};
 use crate::network::{address_text, named, sn_text, sync_text, Event, NetworkLog};
 use crate::profile::Profile;
@@ -122,7 +122,7 @@ fn SyncCard() -> impl IntoView {
             ),
         })
     };
-    let result = crate::views::widgets::signal(None::<String>);
+    let result = signal(None::<String>);
     let reject = move || {
         send(c, Command::DesynchroRequest { reset: 1 }, move |r| {
             result.set(Some(match r {
@@ -229,9 +229,9 @@ fn AlarmCard() -> impl IntoView {
 fn RepeaterCallCard() -> impl IntoView {
     let c = use_console();
     let net = c.modem.network;
-    let tx_pos = crate::views::widgets::signal("0".to_string());
-    let threshold = crate::views::widgets::signal("40".to_string());
-    let problem = crate::views::widgets::signal(None::<String>);
+    let tx_pos = signal("0".to_string());
+    let threshold = signal("40".to_string());
+    let problem = signal(None::<String>);
     let call = move || {
         let pos = tx_pos
             .get_untracked()
@@ -334,7 +334,7 @@ fn SpyCard() -> impl IntoView {
 fn SimulatedServers() -> impl IntoView {
     let c = use_console();
     let servers = c.sim.servers;
-    let scale = crate::views::widgets::signal(1u64);
+    let scale = signal(1u64);
     // The rows as HTML, their buttons handled by one listener on the
     // table (as [`text_table`]): `data-node` says which Server.
     let rows = move || {

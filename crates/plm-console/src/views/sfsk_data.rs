@@ -5,7 +5,7 @@
 
 use super::network::send;
 use super::seconds;
-use super::widgets::{button, note, set_checked, set_value, text_input, text_table};
+use super::widgets::{button, note, set_checked, set_value, signal, text_input, text_table};
 use crate::network::{address_text, named};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -56,12 +56,12 @@ fn payload(text: &str, hex: bool) -> Result<Vec<u8>, String> {
 #[component]
 fn SendCard() -> impl IntoView {
     let c = use_console();
-    let da = crate::views::widgets::signal("001".to_string());
-    let ic = crate::views::widgets::signal("0".to_string());
-    let text = crate::views::widgets::signal("?".to_string());
-    let hex = crate::views::widgets::signal(false);
-    let problem = crate::views::widgets::signal(None::<String>);
-    let result = crate::views::widgets::signal(None::<String>);
+    let da = signal("001".to_string());
+    let ic = signal("0".to_string());
+    let text = signal("?".to_string());
+    let hex = signal(false);
+    let problem = signal(None::<String>);
+    let result = signal(None::<String>);
     let layer = move || c.modem.network.with(|n| n.layer());
     let send_frame = move || {
         let layer = c.modem.network.with_untracked(|n| n.layer());

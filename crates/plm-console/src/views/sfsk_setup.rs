@@ -3,7 +3,7 @@
 //! the checks of the declarative MIB ([`crate::mibform::build`]), and for
 //! a MAC Server its local address (0001h, Table 74).
 
-use super::widgets::{button, note, on_event, text_input};
+use super::widgets::{button, note, on_event, signal, text_input};
 use crate::mibform::{build, input_text, Texts};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -50,17 +50,17 @@ pub fn SetupCard() -> impl IntoView {
     };
     let text = |f: &'static plm_core::field::Field| {
         let b = base();
-        crate::views::widgets::signal(input_text(f, &b))
+        signal(input_text(f, &b))
     };
-    let role = crate::views::widgets::signal("0".to_string());
+    let role = signal("0".to_string());
     let mains = text(&plc::MAINS_FREQUENCY);
     let bit_rate = text(&plc::BIT_RATE);
     let f0 = text(&plc::F0);
     let f1 = text(&plc::F1);
     let gain = text(&plc::TARGET_OUTPUT_GAIN);
-    let address = crate::views::widgets::signal("001".to_string());
-    let problem = crate::views::widgets::signal(None::<String>);
-    let result = crate::views::widgets::signal(None::<String>);
+    let address = signal("001".to_string());
+    let problem = signal(None::<String>);
+    let result = signal(None::<String>);
     let server_mac = move || {
         role.get()
             .parse::<usize>()

@@ -3,7 +3,7 @@
 //! UART byte faults, modem reset and unplug, and what happens on the line.
 
 use super::seconds;
-use super::widgets::{button, escape, on_click, on_event};
+use super::widgets::{button, escape, on_click, on_event, signal};
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::st7580::fields::MODULATIONS;
@@ -71,7 +71,7 @@ pub fn SimulatorView() -> impl IntoView {
 #[component]
 fn StreetCard() -> impl IntoView {
     let c = use_console();
-    let choice = crate::views::widgets::signal(c.sim.lamps.get_untracked());
+    let choice = signal(c.sim.lamps.get_untracked());
     view! {
         <article class="card" id="sim-street">
             <h3>"Street"</h3>
@@ -114,11 +114,11 @@ fn StreetCard() -> impl IntoView {
 #[component]
 fn FailureRate() -> impl IntoView {
     let c = use_console();
-    let text = crate::views::widgets::signal(super::fixed(
+    let text = signal(super::fixed(
         f64::from_bits(c.sim.failure_rate.get_untracked()),
         2,
     ));
-    let message = crate::views::widgets::signal(None::<String>);
+    let message = signal(None::<String>);
     let apply = move || match super::decimal(&text.get_untracked()) {
         Some(rate) if (0.0..=60.0).contains(&rate) => {
             c.sim.failure_rate.set(rate.to_bits());
@@ -152,7 +152,7 @@ fn FailureRate() -> impl IntoView {
 #[component]
 fn TopologyCard() -> impl IntoView {
     let c = use_console();
-    let choice = crate::views::widgets::signal(c.sim.nodes.get_untracked());
+    let choice = signal(c.sim.nodes.get_untracked());
     view! {
         <article class="card" id="sim-topology">
             <h3>"Topology"</h3>
@@ -245,10 +245,10 @@ fn percent(text: &str) -> Option<f64> {
 fn LineCard() -> impl IntoView {
     let c = use_console();
     let defaults = LineConfig::default();
-    let noise = crate::views::widgets::signal(super::fixed(defaults.noise_dbuv, 0));
-    let loss = crate::views::widgets::signal("0".to_string());
-    let corruption = crate::views::widgets::signal("0".to_string());
-    let message = crate::views::widgets::signal(None::<String>);
+    let noise = signal(super::fixed(defaults.noise_dbuv, 0));
+    let loss = signal("0".to_string());
+    let corruption = signal("0".to_string());
+    let message = signal(None::<String>);
     let apply = move || {
         let noise_dbuv = match super::decimal(&noise.get_untracked()) {
             Some(v) if (0.0..=130.0).contains(&v) => v,
@@ -295,7 +295,7 @@ fn LineCard() -> impl IntoView {
 fn UartCard() -> impl IntoView {
     let c = use_console();
     // Modem to host when set (a bool: a signal type the page has).
-    let up = crate::views::widgets::signal(false);
+    let up = signal(false);
     let dir = move || {
         if up.get_untracked() {
             Dir::ModemToHost
@@ -303,10 +303,10 @@ fn UartCard() -> impl IntoView {
             Dir::HostToModem
         }
     };
-    let drop = crate::views::widgets::signal("0".to_string());
-    let corrupt = crate::views::widgets::signal("0".to_string());
-    let delay = crate::views::widgets::signal("0".to_string());
-    let message = crate::views::widgets::signal(None::<String>);
+    let drop = signal("0".to_string());
+    let corrupt = signal("0".to_string());
+    let delay = signal("0".to_string());
+    let message = signal(None::<String>);
     let inject = move |f: Fault| {
         c.with_simulator(|s| s.inject(f));
         message.set(Some("armed: it hits the next byte".into()));

@@ -4,7 +4,7 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
-use super::widgets::{button, checkbox, live_button, on_click, on_event, text_input};
+use super::widgets::{button, checkbox, live_button, on_click, on_event, signal, text_input};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -15,13 +15,13 @@ use plm_core::app::{Address, Message, Request};
 #[component]
 pub fn StreetView() -> impl IntoView {
     let street = use_console().street;
-    let filter = crate::views::widgets::signal(String::new());
+    let filter = signal(String::new());
     // The column sorted by, `-` before it when descending: a String signal
     // as the page has many, not one of its own type (docs/console.md, "Size").
-    let sort = crate::views::widgets::signal(String::from("address"));
+    let sort = signal(String::from("address"));
     let selected = street.selected;
-    let focus = crate::views::widgets::signal(None::<Address>);
-    let message = crate::views::widgets::signal(None::<String>);
+    let focus = signal(None::<Address>);
+    let message = signal(None::<String>);
     // The rows shown, sorted and filtered; the table keys its lines by
     // address and each cell follows its own row, so a reading changes one
     // cell and a sort moves lines, without rebuilding the table.
@@ -238,7 +238,7 @@ fn GroupActions(
     message: RwSignal<Option<String>>,
 ) -> impl IntoView {
     let street = use_console().street;
-    let level = crate::views::widgets::signal(String::from("50"));
+    let level = signal(String::from("50"));
     let parse = move || dimming_value(&level.get_untracked());
     let dim = move |targets: Option<Vec<Address>>| {
         let v = match parse() {

@@ -2,7 +2,7 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
-use super::widgets::{button, on_click, on_event};
+use super::widgets::{button, on_click, on_event, signal};
 use super::{seconds, spaced};
 use crate::app::Tab;
 use crate::stores::use_console;
@@ -20,12 +20,12 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
     // The filter's three choices as String signals (a signal type the page
     // has, rather than one of `Filter`'s own).
     let filter = FilterChoice {
-        from: crate::views::widgets::signal(String::new()),
-        kind: crate::views::widgets::signal(String::new()),
-        command: crate::views::widgets::signal(String::new()),
+        from: signal(String::new()),
+        kind: signal(String::new()),
+        command: signal(String::new()),
     };
-    let selected = crate::views::widgets::signal(None::<u64>);
-    let message = crate::views::widgets::signal(None::<String>);
+    let selected = signal(None::<u64>);
+    let message = signal(None::<String>);
     // Hidden, the table keeps its rows and does not even look at the log:
     // redrawing it would only hold up the host's next ACK (issue 13), and
     // its tab brings it up to date.

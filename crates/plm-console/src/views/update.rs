@@ -8,7 +8,7 @@
 
 use super::files::{chosen_file, download, download_bytes, read_bytes};
 use super::widgets::{
-    button, escape, live_button, note, on_event, option_html, select, text_input,
+    button, escape, live_button, note, on_event, option_html, select, signal, text_input,
 };
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
@@ -72,11 +72,11 @@ fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
 #[component]
 pub fn UpdateView() -> impl IntoView {
     let street = use_console().street;
-    let chosen = crate::views::widgets::signal(None::<Chosen>);
-    let choice = crate::views::widgets::signal(String::from("all"));
-    let message = crate::views::widgets::signal(None::<String>);
-    let make_release = crate::views::widgets::signal(String::from("1.5"));
-    let make_size = crate::views::widgets::signal(String::from("24576"));
+    let chosen = signal(None::<Chosen>);
+    let choice = signal(String::from("all"));
+    let message = signal(None::<String>);
+    let make_release = signal(String::from("1.5"));
+    let make_size = signal(String::from("24576"));
     let running = move || {
         street.campaign.track();
         street.read(|s| s.campaign().map(|c| !c.update.is_done()))
@@ -126,7 +126,7 @@ pub fn UpdateView() -> impl IntoView {
     };
     // A campaign kept in storage and not running here: after a reload, or
     // a new connection (the cable pulled and plugged in again).
-    let discarded = crate::views::widgets::signal(0u32);
+    let discarded = signal(0u32);
     let cut_short = move || {
         street.campaign.track();
         street.port.track();
