@@ -377,10 +377,7 @@ fn actions_html(object: &'static Object, secret: bool) -> String {
 
 /// The `data-action` of what a click was on (a button, the Reveal box).
 fn action_of(ev: &web_sys::MouseEvent) -> String {
-    use wasm_bindgen::JsCast;
-    ev.target()
-        .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
-        .and_then(|e| e.closest("[data-action]").ok().flatten())
+    super::widgets::closest(ev, "[data-action]")
         .and_then(|e| e.get_attribute("data-action"))
         .unwrap_or_default()
 }
@@ -388,10 +385,7 @@ fn action_of(ev: &web_sys::MouseEvent) -> String {
 /// What is typed into a field's input (found by its `name`), into
 /// `inputs` without redrawing the form.
 fn typed(object: &'static Object, inputs: RwSignal<Inputs>, ev: &web_sys::Event) {
-    use wasm_bindgen::JsCast;
-    let name = ev
-        .target()
-        .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+    let name = super::widgets::closest(ev, "[name]")
         .and_then(|e| e.get_attribute("name"))
         .unwrap_or_default();
     let Some(field) = object.fields.iter().find(|f| f.name == name) else {

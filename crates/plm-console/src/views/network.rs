@@ -363,12 +363,7 @@ fn SimulatedServers() -> impl IntoView {
         })
     };
     let act = move |ev: leptos::ev::MouseEvent| {
-        use wasm_bindgen::JsCast;
-        let Some(b) = ev
-            .target()
-            .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
-            .and_then(|e| e.closest("button[data-node]").ok().flatten())
-        else {
+        let Some(b) = super::widgets::closest(&ev, "button[data-node]") else {
             return;
         };
         let node: usize = b

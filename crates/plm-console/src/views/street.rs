@@ -4,7 +4,9 @@
 //! or all, alerts; a lamp's own page is [`super::lamp`].
 
 use super::files::download;
-use super::widgets::{button, checkbox, live_button, on_click, on_event, signal, text_input};
+use super::widgets::{
+    button, checkbox, closest, live_button, on_click, on_event, signal, text_input,
+};
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
@@ -23,8 +25,8 @@ pub fn StreetView() -> impl IntoView {
     let focus = signal(None::<Address>);
     let message = signal(None::<String>);
     // The rows shown, sorted and filtered; the table keys its lines by
-    // address and each cell follows its own row, so a reading changes one
-    // cell and a sort moves lines, without rebuilding the table.
+    // address and each line follows its own lamp, so a reading redraws one
+    // line and a sort moves lines, without rebuilding the table.
     let rows = Memo::new(move |_| {
         street.version.track();
         let now = street.now.get();
@@ -115,16 +117,15 @@ pub fn StreetView() -> impl IntoView {
                         // its lamp or its selection changes.
                         <tbody
                             on:click=on_click(move |ev| {
-                                let target = event_element(&ev);
-                                let in_pick = target.as_ref().and_then(|t| t.closest("td.pick").ok().flatten());
-                                if in_pick.is_none() {
-                                    if let Some(a) = target.as_ref().and_then(row_address) {
+                                // The selection box's cell does not open the lamp.
+                                if closest(&ev, "td.pick").is_none() {
+                                    if let Some(a) = row_address(&ev) {
                                         focus.set(Some(a));
                                     }
                                 }
                             })
                             on:change=on_event(move |ev| {
-                                let Some(a) = event_element(&ev).as_ref().and_then(row_address) else {
+                                let Some(a) = row_address(&ev) else {
                                     return;
                                 };
                                 let on = event_target_checked(&ev);
@@ -352,16 +353,9 @@ fn row_html(row: Option<&Row>, picked: bool) -> String {
     html
 }
 
-/// The element an event happened on.
-fn event_element(ev: &web_sys::Event) -> Option<web_sys::Element> {
-    use wasm_bindgen::JsCast;
-    ev.target()?.dyn_into().ok()
-}
-
-/// The lamp of the fleet row holding `element` (its `data-address`).
-fn row_address(element: &web_sys::Element) -> Option<Address> {
-    let row = element.closest("tr[data-address]").ok()??;
-    let hex = row.get_attribute("data-address")?;
+/// The lamp of the fleet row an event happened in (its `data-address`).
+fn row_address(ev: &web_sys::Event) -> Option<Address> {
+    let hex = closest(ev, "tr[data-address]")?.get_attribute("data-address")?;
     u64::from_str_radix(&hex, 16).ok().map(key_address)
 }
 

@@ -2,7 +2,7 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
-use super::widgets::{button, on_click, on_event, signal};
+use super::widgets::{button, on_click, on_event, option_html, signal};
 use super::{seconds, spaced};
 use crate::app::Tab;
 use crate::stores::use_console;
@@ -167,11 +167,8 @@ fn FilterControls(filter: FilterChoice) -> impl IntoView {
         let mut html = String::from("<option value=\"\">all</option>");
         let mut kept = chosen.is_empty();
         for name in (0..=255u8).filter_map(|code| chip.code_name(code)) {
-            let selected = if name == chosen { " selected" } else { "" };
             kept |= name == chosen;
-            html.push_str(&format!(
-                "<option value=\"{name}\"{selected}>{name}</option>"
-            ));
+            option_html(&mut html, name, name, name == chosen);
         }
         if !kept {
             filter.command.set(String::new());

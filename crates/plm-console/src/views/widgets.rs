@@ -267,3 +267,15 @@ pub fn checkbox(
     }
     .into_any()
 }
+
+/// The element an event happened in, or its nearest ancestor matching
+/// `selector`: what a listener delegated to a container (a table of HTML
+/// rows, a card's HTML buttons) acts on.
+pub fn closest(ev: &web_sys::Event, selector: &str) -> Option<web_sys::Element> {
+    use wasm_bindgen::JsCast;
+    ev.target()?
+        .dyn_into::<web_sys::Element>()
+        .ok()?
+        .closest(selector)
+        .ok()?
+}
