@@ -233,6 +233,23 @@ impl TrafficLog {
     }
 }
 
+/// Whether rows shown from the log changed: (how many matched, the entries
+/// shown), compared by identity (the log only appends, drops or clears),
+/// not field by field. The compare of every memo of log rows.
+pub fn rows_changed(
+    old: Option<&(usize, Vec<Arc<Entry>>)>,
+    new: Option<&(usize, Vec<Arc<Entry>>)>,
+) -> bool {
+    match (old, new) {
+        (Some(a), Some(b)) => {
+            a.0 != b.0
+                || a.1.len() != b.1.len()
+                || a.1.iter().zip(&b.1).any(|(x, y)| !Arc::ptr_eq(x, y))
+        }
+        _ => true,
+    }
+}
+
 /// What an import read.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Imported {

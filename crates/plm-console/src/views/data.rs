@@ -363,16 +363,7 @@ fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
             rows.drain(..total.saturating_sub(INDICATION_ROWS));
             (total, rows)
         },
-        |old: Option<&(usize, Vec<Arc<Entry>>)>, new: Option<&(usize, Vec<Arc<Entry>>)>| match (
-            old, new,
-        ) {
-            (Some(a), Some(b)) => {
-                a.0 != b.0
-                    || a.1.len() != b.1.len()
-                    || a.1.iter().zip(&b.1).any(|(x, y)| !Arc::ptr_eq(x, y))
-            }
-            _ => true,
-        },
+        crate::traffic::rows_changed,
     );
     view! {
         <article class="card wide" id="data-indications">

@@ -53,16 +53,7 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
                 (total, shown)
             })
         },
-        |old: Option<&(usize, Vec<Arc<Entry>>)>, new: Option<&(usize, Vec<Arc<Entry>>)>| match (
-            old, new,
-        ) {
-            (Some(a), Some(b)) => {
-                a.0 != b.0
-                    || a.1.len() != b.1.len()
-                    || a.1.iter().zip(&b.1).any(|(x, y)| !Arc::ptr_eq(x, y))
-            }
-            _ => true,
-        },
+        crate::traffic::rows_changed,
     );
 
     view! {
