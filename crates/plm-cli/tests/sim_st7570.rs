@@ -227,6 +227,20 @@ fn mac_client() -> Vec<u8> {
     p.encode()
 }
 
+/// A MAC frame from the Client to `da`, no credit: what the tests send.
+fn mac_frame(da: u16, m_sdu: &[u8]) -> MacData {
+    MacData {
+        credit: Credit {
+            ic: 0,
+            cc: 0,
+            dc: 0,
+        },
+        address: Address { sa: 0, da },
+        pad: 0,
+        m_sdu: m_sdu.to_vec(),
+    }
+}
+
 #[test]
 fn plm_sim_chip_st7570_through_rfc2217_and_the_host_engine() {
     let mut server = Server::start(&["--chip", "st7570", "--listen", "127.0.0.1:0"]);
@@ -287,16 +301,7 @@ fn plm_sim_chip_st7570_through_rfc2217_and_the_host_engine() {
     );
 
     // A MAC frame to Server 2, its echo as a MAC data indication.
-    let hello = MacData {
-        credit: Credit {
-            ic: 0,
-            cc: 0,
-            dc: 0,
-        },
-        address: Address { sa: 0, da: 2 },
-        pad: 0,
-        m_sdu: b"hello over RFC 2217".to_vec(),
-    };
+    let hello = mac_frame(2, b"hello over RFC 2217");
     match host.request(&Command::MacDataRequest(hello.clone())) {
         Command::DataConfirm { confirm_code } => assert_eq!(confirm_code, 0xFF, "LM_OK"),
         other => panic!("{other:?}"),
@@ -357,16 +362,7 @@ fn plm_sim_st7570_alarms_reach_the_client() {
     let mut host = Host::new(port);
     host.write(index::PLC_CONFIGURATION, &mac_client());
     host.layer = Layer::Mac;
-    let ask = MacData {
-        credit: Credit {
-            ic: 0,
-            cc: 0,
-            dc: 0,
-        },
-        address: Address { sa: 0, da: 1 },
-        pad: 0,
-        m_sdu: b"?".to_vec(),
-    };
+    let ask = mac_frame(1, b"?");
     match host.request(&Command::MacDataRequest(ask)) {
         Command::DataConfirm { confirm_code } => assert_eq!(confirm_code, 0xFF, "LM_OK"),
         other => panic!("{other:?}"),
