@@ -146,6 +146,44 @@ test('the traffic log exports to JSON Lines and imports again', async (t) => {
   assert.equal(ping.fields.data, '504c4d21');
 });
 
+test('a long traffic log draws only the rows in view, follows the newest, and scrolls back to the first', async (t) => {
+  const page = await open(t);
+  await page.waitForFunction(() => window.plmBench !== undefined);
+  // 200 MIB reads: about a thousand elements, five to an exchange.
+  const r = await page.evaluate(() => window.plmBench.mibReads(200, 0x0a, false));
+  assert.equal(r.failed, 0, r.firstError);
+  const kept = async () => Number((await page.textContent('#traffic-counts')).match(/^(\d+) elements kept/)[1]);
+  await page.waitForFunction(() => /^(\d+)/.exec(document.querySelector('#traffic-counts').textContent)[1] >= 1000);
+  const n = await kept();
+  const rows = page.locator('#traffic-table tbody tr');
+  const seqs = async () => (await page.locator('#traffic-table tbody td.num').allTextContents()).map(Number);
+  // Following: the newest element (numbered from 0) is the last row, and
+  // few rows are drawn.
+  await page.waitForFunction((n) => document.querySelector('#traffic-table tbody tr:last-child td.num')?.textContent === String(n - 1), n);
+  assert.ok((await rows.count()) < 60, `${await rows.count()} rows drawn of ${n}`);
+  const wrap = page.locator('#traffic-wrap');
+  const atBottom = () => wrap.evaluate((w) => w.scrollTop + w.clientHeight >= w.scrollHeight - 11);
+  assert.ok(await atBottom(), 'scrolled to the newest');
+  // Each row one line: the scroll bar is the whole log's.
+  const height = await wrap.evaluate((w) => w.scrollHeight);
+  assert.ok(Math.abs(height - (n * 22 + 28)) < 40, `${height} px for ${n} rows`);
+  await shot(page, 'traffic-long');
+  // Back to the top: the first elements, the boot's reset among them.
+  await wrap.evaluate((w) => w.scrollTo(0, 0));
+  await page.waitForFunction(() => document.querySelector('#traffic-table tbody td.num')?.textContent === '0');
+  assert.ok((await titles(page)).includes('BIO_ResetIndication'));
+  assert.deepEqual((await seqs()).slice(0, 3), [0, 1, 2]);
+  // Scrolled up, it stays put while the log grows.
+  const before = await seqs();
+  await page.evaluate(() => window.plmBench.mibReads(20, 0x0a, false));
+  await page.waitForFunction((n) => /^(\d+)/.exec(document.querySelector('#traffic-counts').textContent)[1] > n, n);
+  assert.deepEqual(await seqs(), before);
+  // A row clicked there shows its element whole.
+  await rows.filter({ hasText: 'BIO_ResetIndication' }).first().click();
+  assert.match(await page.textContent('#traffic-details pre'), /"reset_cause"/);
+  await page.locator('#traffic-table tbody tr.selected', { hasText: 'BIO_ResetIndication' }).waitFor();
+});
+
 test('the simulator unplugs the cable and corrupts a byte; the console says so, and recovers', async (t) => {
   const page = await open(t, '#simulator');
   await page.selectOption('#sim-nodes', '2');

@@ -18,7 +18,7 @@ export async function shot(page, name) {
   await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: false });
 }
 
-/** Titles of the traffic rows shown (Element column). */
+/** Titles of the traffic rows drawn (Element column): those in view. */
 export async function titles(page) {
   return page.locator('#traffic-table tbody tr td.title').allTextContents();
 }
@@ -102,13 +102,15 @@ export const ST7570_F = { card: '#mib-00a1', field: 'f0', range: '3000..=140000'
 export async function exportImport(page, fileName, shotName) {
   await tab(page, 'traffic');
   await page.click('#traffic-pause');
+  // The rows drawn (those in view) and how many the log keeps.
   const before = await titles(page);
+  const kept = Number(/^(\d+) elements kept/.exec(await page.textContent('#traffic-counts'))[1]);
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#traffic-export')]);
   assert.equal(download.suggestedFilename(), 'plm-traffic.jsonl');
   const file = path.join(artifacts, fileName);
   await download.saveAs(file);
   const lines = (await fs.readFile(file, 'utf8')).trim().split('\n');
-  assert.equal(lines.length, before.length);
+  assert.equal(lines.length, kept);
   const entries = lines.map((l) => JSON.parse(l));
   for (const e of entries) {
     assert.equal(typeof e.time_us, 'number');

@@ -2,16 +2,13 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
-use super::widgets::{button, on_click, on_event, option_html, signal};
+use super::widgets::{button, closest, escape, on_click, on_event, option_html, signal};
 use super::{seconds, spaced};
 use crate::app::Tab;
 use crate::stores::use_console;
-use crate::traffic::{Entry, Filter, CAPACITY};
+use crate::traffic::{Entry, Filter, CAPACITY, ROW_PX};
 use leptos::prelude::*;
 use std::sync::Arc;
-
-/// Rows rendered at most; the log keeps [`CAPACITY`].
-pub const MAX_ROWS: usize = 500;
 
 /// The inspector, on the page's `tab`.
 #[component]
@@ -40,21 +37,65 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
             let f = filter.get();
             let paused = c.traffic.paused_at.get();
             c.traffic.log.with(|log| {
-                let matching: Vec<&Arc<Entry>> = log
+                let matching: Vec<Arc<Entry>> = log
                     .iter()
                     .filter(|e| paused.is_none_or(|p| e.seq <= p))
                     .filter(|e| f.matches(e))
+                    .map(Arc::clone)
                     .collect();
-                let total = matching.len();
-                let shown: Vec<Arc<Entry>> = matching[total.saturating_sub(MAX_ROWS)..]
-                    .iter()
-                    .map(|e| Arc::clone(e))
-                    .collect();
-                (total, shown)
+                (matching.len(), matching)
             })
         },
         crate::traffic::rows_changed,
     );
+    // Where the table is scrolled, and whether it follows the newest rows
+    // (scrolled to the bottom, as it opens).
+    let top = signal(0u32);
+    let follow = signal(true);
+    // Only the rows in view are in the page ([`crate::traffic::window`]),
+    // written as HTML; the table's margins keep the room of the others, so
+    // that the scroll bar is the whole log's.
+    Effect::new(move |drawn: Option<String>| {
+        let follow = follow.get();
+        let top = if follow { 0 } else { top.get() };
+        let chosen = selected.get();
+        // The table's height at most (style.css `.table-wrap`: 100vh - 190px).
+        let page_px = window().inner_height().ok().and_then(|h| h.as_f64());
+        let view_px = (page_px.unwrap_or(900.0) - 190.0).max(220.0) as u32;
+        let (html, above, below) = rows.with(|(_, all)| {
+            let w = crate::traffic::window(all.len(), top, view_px, follow);
+            let html: String = all[w.clone()].iter().map(|e| row_html(e, chosen)).collect();
+            (html, w.start, all.len() - w.end)
+        });
+        // What the body holds: written only when it changes.
+        let mut drawn = drawn.unwrap_or_default();
+        let doc = document();
+        if let (Some(table), Ok(Some(body))) = (
+            doc.get_element_by_id("traffic-table"),
+            doc.query_selector("#traffic-table tbody"),
+        ) {
+            let _ = table.set_attribute(
+                "style",
+                &format!(
+                    "margin: {}px 0 {}px",
+                    above as u32 * ROW_PX,
+                    below as u32 * ROW_PX
+                ),
+            );
+            if drawn != html {
+                body.set_inner_html(&html);
+                drawn = html;
+            }
+        }
+        if follow {
+            request_animation_frame(|| {
+                if let Some(wrap) = document().get_element_by_id("traffic-wrap") {
+                    wrap.scroll_to_with_x_and_y(0.0, 1e9);
+                }
+            });
+        }
+        drawn
+    });
 
     view! {
         <div class="toolbar" id="traffic-toolbar">
@@ -78,7 +119,7 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
                 if shown() {
                     c.traffic.log.track();
                 }
-                let (total, shown) = rows.with(|(t, s)| (*t, s.len()));
+                let total = rows.with(|r| r.0);
                 c.traffic
                     .log
                     .with_untracked(|l| {
@@ -87,9 +128,6 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
                             s.push_str(&format!(", {} oldest dropped", l.dropped()));
                         }
                         s.push_str(&format!("; {total} match the filters"));
-                        if shown < total {
-                            s.push_str(&format!(", the last {shown} shown"));
-                        }
                         s
                     })
             }}
@@ -97,30 +135,45 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
         </p>
         {move || message.get().map(|m| view! { <p class="message" id="traffic-message">{m}</p> })}
         <div class="traffic">
-            <div class="table-wrap">
+            <div
+                class="table-wrap"
+                id="traffic-wrap"
+                on:scroll=on_event(move |ev| {
+                    let Some(wrap) = closest(&ev, "#traffic-wrap") else {
+                        return;
+                    };
+                    // web-sys has scrollTop as an f64 for wasm32, an i32 natively.
+                    #[allow(clippy::useless_conversion)]
+                    let at = f64::from(wrap.scroll_top()).max(0.0) as u32;
+                    let bottom = at as i32 + wrap.client_height() + ROW_PX as i32 / 2
+                        >= wrap.scroll_height();
+                    if top.get_untracked() != at {
+                        top.set(at);
+                    }
+                    if follow.get_untracked() != bottom {
+                        follow.set(bottom);
+                    }
+                })
+            >
                 <table class="log" id="traffic-table">
                     <thead>
                         <tr>
-                            <th>"#"</th>
-                            <th>"Time"</th>
-                            <th>"Way"</th>
-                            <th>"Element"</th>
-                            <th>"Fields"</th>
-                            <th>"Hex"</th>
+                            <th class="num">"#"</th>
+                            <th class="time">"Time"</th>
+                            <th class="way">"Way"</th>
+                            <th class="title">"Element"</th>
+                            <th class="fields">"Fields"</th>
+                            <th class="hex">"Hex"</th>
                         </tr>
                     </thead>
-                    <tbody>
-                        {super::widgets::keyed_rows(
-                            move || rows.with(|r| r.1.iter().map(|e| e.seq).collect()),
-                            move |seq| {
-                                // The row of an entry shown (the log holds them in order).
-                                let entry = rows.with_untracked(|r| {
-                                    r.1.binary_search_by_key(&seq, |e| e.seq).ok().map(|i| Arc::clone(&r.1[i]))
-                                });
-                                entry.map(|e| view! { <Row entry=e selected=selected/> }).into_any()
-                            },
-                        )}
-                    </tbody>
+                    <tbody on:click=on_click(move |ev| {
+                        let seq = closest(&ev, "tr")
+                            .and_then(|tr| tr.get_attribute("data-seq"))
+                            .and_then(|s| s.parse().ok());
+                        if seq.is_some() {
+                            selected.set(seq);
+                        }
+                    })></tbody>
                 </table>
             </div>
             <Details selected=selected/>
@@ -291,34 +344,40 @@ fn ExportImport(message: RwSignal<Option<String>>) -> impl IntoView {
     }
 }
 
-#[component]
-fn Row(entry: Arc<Entry>, selected: RwSignal<Option<u64>>) -> impl IntoView {
-    let seq = entry.seq;
-    let from = entry.from().to_string();
-    let way = match from.as_str() {
+/// Characters of a Fields or Hex cell laid out: more than its line can
+/// show on the widest screen (the browser shapes the text it is given,
+/// shown or not).
+const CELL_CHARS: usize = 160;
+
+/// One element of the log as the HTML of its row; the whole element is
+/// in the Details panel when the row is clicked.
+fn row_html(e: &Entry, selected: Option<u64>) -> String {
+    let from = e.from();
+    let way = match from {
         "host" => "→",
         "modem" => "←",
         _ => "·",
     };
-    let bad = entry.decoded.checksum_ok == Some(false)
-        || entry.decoded.kind == "garbage"
-        || entry.decoded.kind == "nak"
-        || entry.decoded.error.is_some();
-    view! {
-        <tr
-            class=format!("from-{from} kind-{}", entry.decoded.kind)
-            class:bad=bad
-            class:selected=move || selected.get() == Some(seq)
-            on:click=on_click(move |_| selected.set(Some(seq)))
-        >
-            <td class="num">{seq}</td>
-            <td class="time">{entry.at.map(seconds).unwrap_or_else(|| "–".into())}</td>
-            <td class="way" title=from.clone()>{way}</td>
-            <td class="title">{entry.title()}</td>
-            <td class="fields">{entry.summary.clone()}</td>
-            <td class="hex">{spaced(&entry.decoded.hex)}</td>
-        </tr>
-    }
+    let d = &e.decoded;
+    let bad =
+        d.checksum_ok == Some(false) || d.kind == "garbage" || d.kind == "nak" || d.error.is_some();
+    // What a line can show; the whole text is the cell's tooltip.
+    let clip = |t: &str| {
+        let shown: String = t.chars().take(CELL_CHARS).collect();
+        (escape(&shown), escape(t))
+    };
+    let (fields, all_fields) = clip(&e.summary);
+    let (hex, all_hex) = clip(&spaced(&d.hex));
+    format!(
+        "<tr data-seq=\"{seq}\" class=\"from-{from} kind-{kind}{bad}{chosen}\"><td class=\"num\">{seq}</td><td class=\"time\">{time}</td><td class=\"way\" title=\"{from}\">{way}</td><td class=\"title\">{title}</td><td class=\"fields\" title=\"{all_fields}\">{fields}</td><td class=\"hex\" title=\"{all_hex}\">{hex}</td></tr>",
+        seq = e.seq,
+        from = escape(from),
+        kind = escape(&d.kind),
+        bad = if bad { " bad" } else { "" },
+        chosen = if selected == Some(e.seq) { " selected" } else { "" },
+        time = e.at.map(seconds).unwrap_or_else(|| "–".into()),
+        title = escape(&e.title()),
+    )
 }
 
 #[component]
