@@ -79,7 +79,7 @@ export async function refusedFrequency(page, shotName, chip = ST7580_F) {
   await card.locator(`input[name=${chip.field}]`).fill('200000');
   await card.locator('[data-action=write]').click();
   const reason = card.locator(`tr[data-field=${chip.field}] [data-role=problem]`);
-  await reason.filter({ hasText: `200000 is out of range ${chip.range} Hz` }).waitFor();
+  await reason.filter({ hasText: `200000 is out of range: ${chip.range} Hz` }).waitFor();
   assert.ok(await reason.isVisible());
   assert.match(await card.locator('[data-role=status]').textContent(), /^nothing sent/);
   await shot(page, shotName);
@@ -92,8 +92,8 @@ export async function refusedFrequency(page, shotName, chip = ST7580_F) {
 }
 
 /** The frequency field of each chip's PHY configuration object. */
-export const ST7580_F = { card: '#mib-01', field: 'high_frequency', range: '3000..=148500', write: 'MIB_WriteRequest', reset: true };
-export const ST7570_F = { card: '#mib-00a1', field: 'f0', range: '3000..=140000', write: 'CMD_WriteDBRequest', reset: false };
+export const ST7580_F = { card: '#mib-01', field: 'high_frequency', range: '3000 to 148500', write: 'MIB_WriteRequest', reset: true };
+export const ST7570_F = { card: '#mib-00a1', field: 'f0', range: '3000 to 140000', write: 'CMD_WriteDBRequest', reset: false };
 
 /**
  * Traffic view: export the log to JSON Lines, clear, import it again and

@@ -163,7 +163,7 @@ v("SS_DataRequest header length beyond the buffer", "UM0932 3.3.19 Table 45, Tab
      warning="the modem will refuse this request with Wrong parameter value (WPV): header length 9 is longer than the 8 bytes given")], "host")
 v("PHY_DataRequest gain byte with unused bits set", "UM0932 3.3.12 Table 35", frame(0x24, bytes([0x08, 0x35]) + b"\xaa"),
   [F(command="PHY_DataRequest", fields={"tx_gain": 21, "unused": 1, "payload": "aa"},
-     warning="the modem will refuse this request with Wrong parameter value (WPV): tx_gain: 53 is out of range 0..=31 (bits 5-7 of the TX gain byte are unused: 0)")], "host")
+     warning="the modem will refuse this request with Wrong parameter value (WPV): tx_gain: 53 is out of range: 0 to 31 (bits 5-7 of the TX gain byte are unused: 0)")], "host")
 v("a frame hidden after a false start is found", "UM0932 3.2.6", bytes([0x02, 0xF0]) + frame(0x2C),
   [dict(kind="garbage"), F(command="PingRequest")], "host")
 

@@ -373,7 +373,7 @@ mod tests {
         let p = build(o, o.default, &i).unwrap_err();
         assert_eq!(
             p.fields.get("high_frequency").map(String::as_str),
-            Some("200000 is out of range 3000..=148500 Hz")
+            Some("200000 is out of range: 3000 to 148500 Hz")
         );
         assert_eq!(
             p.fields.get("tx_gain").map(String::as_str),
@@ -411,7 +411,7 @@ mod tests {
         let bad = text.replace("014ff0", "030d40");
         assert_eq!(
             parse_profile(&chip, &bad),
-            Err("object 01h: high_frequency: 200000 is out of range 3000..=148500 Hz".into())
+            Err("object 01h: high_frequency: 200000 is out of range: 3000 to 148500 Hz".into())
         );
         assert!(parse_profile(&chip, "{}")
             .unwrap_err()

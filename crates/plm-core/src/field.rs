@@ -411,7 +411,7 @@ impl Field {
             return Err(FieldError {
                 field: self.name,
                 reason: alloc::format!(
-                    "{value} is out of range {}..={}{}",
+                    "{value} is out of range: {} to {}{}",
                     self.min,
                     self.max,
                     self.unit_suffix()
@@ -445,7 +445,7 @@ impl Field {
                 }
                 s
             }
-            _ => alloc::format!("{}..={}{}", self.min, self.max, self.unit_suffix()),
+            _ => alloc::format!("{} to {}{}", self.min, self.max, self.unit_suffix()),
         }
     }
 }
@@ -553,6 +553,6 @@ mod tests {
             .range(3000, 148_500)
             .unit("Hz");
         let e = f.check(200_000).unwrap_err();
-        assert_eq!(e.reason, "200000 is out of range 3000..=148500 Hz");
+        assert_eq!(e.reason, "200000 is out of range: 3000 to 148500 Hz");
     }
 }

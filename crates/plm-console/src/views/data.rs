@@ -141,7 +141,7 @@ fn build(f: &Form, dl_crc_len: usize) -> Result<Command, String> {
         "ss" => Command::SsDataRequest(SsDataRequest {
             params,
             header_length: u8::try_from(number("header length", &f.header_length)?)
-                .map_err(|_| "header length: 0..=255".to_string())?,
+                .map_err(|_| "header length: 0 to 255".to_string())?,
             header_and_payload: payload,
         }),
         _ => Command::DlDataRequest(DataRequest { params, payload }),
@@ -486,7 +486,7 @@ mod tests {
         f.custom_hz = "200000".into();
         assert_eq!(
             build(&f, 4),
-            Err("TX frequency: 200000 is out of range 3000..=148500 Hz".into())
+            Err("TX frequency: 200000 is out of range: 3000 to 148500 Hz".into())
         );
         let mut f = form();
         f.gain = "40".into();

@@ -837,7 +837,7 @@ mod tests {
         })
         .validate()
         .unwrap_err();
-        assert_eq!(e.to_string(), "hours: 24 is out of range 0..=23 h");
+        assert_eq!(e.to_string(), "hours: 24 is out of range: 0 to 23 h");
         assert!(Service::SnSet(32).validate().is_err());
         assert!(Service::ParamSet {
             group: 2,

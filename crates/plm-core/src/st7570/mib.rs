@@ -357,14 +357,16 @@ pub(super) const MAX_PGA_GAIN: &[Field] = &[
     u16le("gain", "GAIN", 0).range(0, 8),
     u16le("pad", "PAD", 2).range(0, 0),
 ];
-pub(super) const SOFT_START: &[Field] =
-    &[twenty_bits("soft_start", "Soft Start", "13 µs"), UNUSED_B20];
+pub(super) const SOFT_START: &[Field] = &[
+    twenty_bits("soft_start", "Soft Start", "× 13 µs"),
+    UNUSED_B20,
+];
 pub(super) const TIME_SLOT_DELAY: &[Field] = &[
     twenty_bits("time_slot_delay_bit", "Time-slot delay bit", "bit"),
     UNUSED_B20,
 ];
 pub(super) const ZC_DELAY: &[Field] = &[
-    twenty_bits("zc_delay_compensation", "ZC delay compensation", "13 µs"),
+    twenty_bits("zc_delay_compensation", "ZC delay compensation", "× 13 µs"),
     UNUSED_B20,
 ];
 

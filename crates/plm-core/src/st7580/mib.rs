@@ -133,7 +133,7 @@ pub mod phy_config {
     /// Byte 7 bits 5-7.
     pub const RESERVED_7: Field = Field::reserved("reserved_7", "Reserved", 7, 5, 3);
     /// Bytes 8-9, signed, 13 µs steps.
-    pub const ZC_DELAY: Field = Field::int("zc_delay", "ZC delay", 8, 2).unit("13 µs");
+    pub const ZC_DELAY: Field = Field::int("zc_delay", "ZC delay", 8, 2).unit("× 13 µs");
     /// Byte 10 bits 0-1.
     pub const PSK_PREAMBLE_LENGTH: Field = Field::enumeration(
         "psk_preamble_length",
@@ -234,7 +234,7 @@ const PHY_DATA_LAYOUT: &[Field] = &[
         6,
         2,
     ),
-    Field::uint("network_period", "Network period", 8, 2).unit("13 µs"),
+    Field::uint("network_period", "Network period", 8, 2).unit("× 13 µs"),
 ];
 const DL_DATA_LAYOUT: &[Field] = &[
     Field::uint(

@@ -194,7 +194,7 @@ mod tests {
         r.params.modulation = Modulation::QPsk;
         r.params.tx_frequency = Some(200_000);
         let e = check_request(&Command::PhyDataRequest(r.clone()), 4).unwrap_err();
-        assert!(e.reason.contains("3000..=148500 Hz"), "{e}");
+        assert!(e.reason.contains("3000 to 148500 Hz"), "{e}");
         r.params.tx_frequency = Some(86_000);
         r.payload = vec![0; 252];
         assert!(check_request(&Command::PhyDataRequest(r.clone()), 4).is_ok());
