@@ -415,6 +415,9 @@ pub struct Session {
     shown: f64,
     /// Elements on the wire among the notes not handed out yet.
     held: usize,
+    /// Notes were just handed out: the next request waits for the next
+    /// tick ([`Session::holds_line`]).
+    hold: bool,
     /// The modem's timeouts (MIB 09h, 000Bh, the chip's at reset); the
     /// host engine waits them plus the transport's latency.
     timeouts: Timeouts,
@@ -440,6 +443,7 @@ impl Session {
             unanswered: 0,
             shown: 0.0,
             held: 0,
+            hold: false,
             timeouts: Timeouts::at_reset(dialect, baud),
             out: Tick::default(),
         };
@@ -580,6 +584,7 @@ impl Session {
     /// down, requests fail at once with its reason instead of waiting for
     /// the link's timeouts.
     pub fn tick(&mut self, page_us: f64, budget: Budget) -> Tick {
+        self.hold = false;
         if self.outstanding() > 0 {
             if let LinkState::Disconnected(why) = self.state() {
                 self.fail_requests(&why);
@@ -606,13 +611,18 @@ impl Session {
     /// one's reply, used to hand the notes out and redraw once per
     /// exchange).
     pub fn take_due(&mut self, page_us: f64) -> Tick {
-        if page_us < self.show_at() {
+        // Notes wait for the answer of the request on the line, so that
+        // the page redraws between two requests ([`Session::holds_line`]);
+        // a busy line's hand-out longer at most.
+        let mid_request = self.active.is_some() && page_us < self.show_at() + BUSY_SHOW_EVERY;
+        if page_us < self.show_at() || mid_request {
             return Tick {
                 notes: Vec::new(),
                 replies: std::mem::take(&mut self.out.replies),
             };
         }
         self.shown = page_us;
+        self.hold = !self.out.notes.is_empty();
         self.take()
     }
 
@@ -620,6 +630,26 @@ impl Session {
     pub fn take(&mut self) -> Tick {
         self.held = 0;
         std::mem::take(&mut self.out)
+    }
+
+    /// Whether the next request waits: notes are due (they wait for the
+    /// answer on the line, [`Session::take_due`]), or were handed out
+    /// since the last tick ([`Session::drawing`]). The page
+    /// redraws then while no frame of the modem can end: the modem answers
+    /// requests, and the next has not left (issue 13: a redraw of the
+    /// Traffic table, 5-8 ms, held up the ACKs of the frames that ended
+    /// under it: p99 9-10 ms, now 1-2 ms). Frames the modem sends of its
+    /// own accord still come when they come. It costs the line the page's
+    /// layout once per hand-out.
+    pub fn holds_line(&self) -> bool {
+        self.hold || (!self.out.notes.is_empty() && self.tick_at >= self.show_at())
+    }
+
+    /// Whether notes were handed out since the last tick: the line is
+    /// quiet, and the console has the page laid out before the
+    /// next tick lets the next request go (`Console::tick`).
+    pub fn drawing(&self) -> bool {
+        self.hold
     }
 
     /// When the notes held back are handed out, µs of the page's clock:
@@ -709,7 +739,7 @@ impl Session {
     /// Hands the next queued request to the engine when none is
     /// outstanding and no duplicate answer is expected.
     fn start_next(&mut self, now: Instant) {
-        if self.active.is_some() {
+        if self.active.is_some() || self.holds_line() {
             return;
         }
         if let Some((_, until)) = self.duplicate_of {
@@ -1033,8 +1063,9 @@ mod tests {
     }
 
     /// Issue 13: the notes of one exchange come at the next screen
-    /// refresh; those of a busy line five times a second, so that the
-    /// page's redraws hold up few ACKs. Replies come at once either way.
+    /// refresh; those of a busy line five times a second, between two
+    /// requests, so that the page's redraws hold up no ACK. Replies come
+    /// at once either way.
     #[test]
     fn notes_come_at_the_next_refresh_or_five_times_a_second_on_a_busy_line() {
         let mut s = session(1);
@@ -1044,10 +1075,16 @@ mod tests {
         let tick = |s: &mut Session, page: &mut f64, replied: &mut Vec<f64>| {
             *page += 1_000.0;
             let t = s.tick(*page, Budget::UNLIMITED);
+            // Notes come between two requests, and the next waits for the
+            // next tick: the page draws while the line is quiet.
+            if !t.notes.is_empty() {
+                assert!(s.active.is_none() && s.drawing(), "notes mid-request");
+            }
             for (r, o) in t.replies {
                 r(o);
                 replied.push(*page);
             }
+            assert!(s.active.is_none() || !s.drawing());
             (!t.notes.is_empty()).then_some((*page, t.notes.len()))
         };
         let seen = Seen::default();

@@ -576,6 +576,12 @@ impl Console {
     /// Lets time pass up to the page's clock, then asks to be run again
     /// when something is next due ([`crate::wake`]).
     pub fn tick(&self) {
+        // A busy line's notes were drawn since the last tick, and the line
+        // waits: the page lays them out now rather than while a frame may
+        // be ending ([`crate::session::Session::holds_line`]).
+        if self.session().borrow().drawing() {
+            crate::wake::lay_out();
+        }
         let budget = || Budget::wall(page_now_us, TICK_BUDGET_US);
         let tick = self.session().borrow_mut().tick(page_now_us(), budget());
         self.apply(tick);

@@ -146,6 +146,18 @@ pub fn install(run: impl Fn() + 'static) {
     let _ = run;
 }
 
+/// Has the browser lay the page out now (style and layout of what the
+/// views changed; the paint still comes with the next frame).
+pub fn lay_out() {
+    #[cfg(target_arch = "wasm32")]
+    if let Some(body) = web_sys::window()
+        .and_then(|w| w.document())
+        .and_then(|d| d.body())
+    {
+        let _ = body.offset_height();
+    }
+}
+
 /// Runs the page's work as soon as the page can (bytes came, the user
 /// acted).
 pub fn soon() {
