@@ -147,9 +147,14 @@ export async function macAsk(page) {
   await page.fill('#sfsk-da', '001');
   await page.fill('#sfsk-payload', '?');
   const before = await page.locator('#sfsk-received-table tbody tr').count();
-  await page.click('#sfsk-send-btn');
   const result = page.locator('#sfsk-result');
-  await result.filter({ hasText: /^(?!sending)./ }).waitFor({ timeout: 25_000 });
+  // A Server's alarm burst on the line makes the MAC layer busy (LM_TU:
+  // "send again"), and a technician sends again.
+  for (let tries = 1; ; tries++) {
+    await page.click('#sfsk-send-btn');
+    await result.filter({ hasText: /^(?!sending)./ }).waitFor({ timeout: 25_000 });
+    if (tries === 3 || !(await result.textContent()).startsWith('CMD_DataConfirm: LM_TU')) break;
+  }
   assert.equal(await result.textContent(), 'CMD_DataConfirm: LM_OK');
   const answers = page.locator('#sfsk-received-table tbody tr', { hasText: '001h → ' }).filter({ hasText: '"!001 phase' });
   await page.waitForFunction(
@@ -158,4 +163,28 @@ export async function macAsk(page) {
     { timeout: 10_000 },
   );
   await answers.first().waitFor();
+}
+
+/**
+ * ST7570, Network view: the Client's alarm goes out (LP_OK), sent again
+ * when a Server's alarm burst kept the line busy (LP_TU).
+ */
+export async function sendAlarm(page) {
+  const history = page.locator('#net-alarm-history');
+  const ok = history.filter({ hasText: 'alarm sent: LP_OK' });
+  const busy = () =>
+    page.evaluate(() => (document.querySelector('#net-alarm-history').textContent.match(/alarm sent: LP_TU/g) ?? []).length);
+  for (let tries = 1; tries <= 3; tries++) {
+    const before = await busy();
+    await page.click('#net-alarm');
+    const busyAgain = page.waitForFunction(
+      (n) => (document.querySelector('#net-alarm-history').textContent.match(/alarm sent: LP_TU/g) ?? []).length > n,
+      before,
+      { timeout: 10_000 },
+    ).then(() => 'busy', () => 'neither');
+    const sent = ok.waitFor({ timeout: 10_000 }).then(() => 'ok', () => 'neither');
+    const got = await Promise.race([sent, busyAgain]);
+    if (got === 'ok') return;
+  }
+  assert.fail('the alarm was not sent: the line stayed busy');
 }

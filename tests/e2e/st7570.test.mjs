@@ -6,7 +6,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { macAsk, macClient, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
+import { macAsk, macClient, refusedFrequency, sendAlarm, shot, ST7570_F, tab, titles } from './journeys.mjs';
 
 let server;
 let base;
@@ -114,8 +114,7 @@ test('a MAC Client asks a Server and sees its answer, the synchronization of tha
   // Alarms both ways: one from Server 001h received, one sent.
   await server.locator('button.alarm').click();
   await page.locator('#net-alarm-history', { hasText: 'alarm received' }).waitFor({ timeout: 10_000 });
-  await page.click('#net-alarm');
-  await page.locator('#net-alarm-history', { hasText: 'alarm sent: LP_OK' }).waitFor({ timeout: 10_000 });
+  await sendAlarm(page);
   await page.locator('#net-alarms').scrollIntoViewIfNeeded();
   await shot(page, 'st7570-network');
 });

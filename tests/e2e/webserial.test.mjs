@@ -20,7 +20,7 @@ import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { launchChromium, serveDist, pageErrors, watchedPage } from './harness.mjs';
-import { exportImport, macAsk, macClient, phyRoundTrip, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
+import { exportImport, macAsk, macClient, sendAlarm, phyRoundTrip, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -484,8 +484,7 @@ test('WebSerial: an ST7570 on the port (plm sim --chip st7570) is made a MAC Cli
   assert.equal(await page.locator('#net-sim').isVisible(), false);
   // A Server's alarm comes in; the Client's own goes out.
   await page.locator('#net-alarm-history', { hasText: 'alarm received' }).waitFor({ timeout: 20_000 });
-  await page.click('#net-alarm');
-  await page.locator('#net-alarm-history', { hasText: 'alarm sent: LP_OK' }).waitFor({ timeout: 10_000 });
+  await sendAlarm(page);
   assert.ok(wireLog(wire).some((e) => e.rts === true), 'T_REQ driven by RTS');
   await shot(page, 'webserial-st7570-network');
   await refusedFrequency(page, 'webserial-st7570-refused', ST7570_F);

@@ -146,6 +146,16 @@ pub fn named(table: &[&'static str], code: u8) -> String {
     Value::Enum { raw: code, name }.to_string()
 }
 
+/// A CONFIRM_CODE of `table` (Tables 43, 48) named, with what it means
+/// when it is not OK (`plm_core::st7570::fields::confirm_meaning`).
+pub fn confirm_text(table: &[&'static str], code: u8) -> String {
+    let name = named(table, code);
+    match f::confirm_meaning(table.get(code as usize).copied().unwrap_or("")) {
+        Some(meaning) => format!("{name}: {meaning}"),
+        None => name,
+    }
+}
+
 /// A MAC CMD_SynchroIndication in words (Table 18).
 pub fn sync_text(s: &MacSync) -> String {
     match *s {
@@ -346,6 +356,31 @@ impl NetworkLog {
 mod tests {
     use super::*;
     use plm_core::st7570::MacData;
+
+    /// A confirm code that is not OK says what it means (Tables 43, 48).
+    #[test]
+    fn confirm_codes_say_what_they_mean() {
+        assert_eq!(
+            confirm_text(&f::MAC_CONFIRM_CODES[..], 0x00),
+            "LM_TU: the MAC layer is busy: send again"
+        );
+        assert_eq!(confirm_text(&f::MAC_CONFIRM_CODES[..], 0xFF), "LM_OK");
+        assert_eq!(confirm_text(&f::ALARM_CONFIRM_CODES[..], 0xFF), "LP_OK");
+        for table in [
+            &f::MAC_CONFIRM_CODES,
+            &f::PHY_CONFIRM_CODES,
+            &f::ALARM_CONFIRM_CODES,
+        ] {
+            for (code, name) in table.iter().enumerate().filter(|(_, n)| !n.is_empty()) {
+                let meant = f::confirm_meaning(name).is_some();
+                assert_eq!(meant, !name.ends_with("_OK"), "{name} ({code:02X}h)");
+            }
+        }
+        assert_eq!(
+            confirm_text(&f::MAC_CONFIRM_CODES[..], 0x07),
+            "7 (undefined)"
+        );
+    }
 
     fn frame(cmd: &Command) -> LocalFrame {
         cmd.to_frame()

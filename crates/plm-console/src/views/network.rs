@@ -7,7 +7,7 @@
 use super::diagnostics::fields_html;
 use super::widgets::{button, escape, on_click, on_event, signal, text_table};
 use super::{fixed, seconds};
-use crate::network::{address_text, named, sn_text, sync_text, Event, NetworkLog};
+use crate::network::{address_text, confirm_text, named, sn_text, sync_text, Event, NetworkLog};
 use crate::profile::Profile;
 use crate::session::Outcome;
 use crate::stores::{use_console, Console};
@@ -201,7 +201,7 @@ fn AlarmCard() -> impl IntoView {
                 Ok(Command::AlarmConfirm { confirm_code }) => {
                     format!(
                         "alarm sent: {}",
-                        named(&f::ALARM_CONFIRM_CODES[..], confirm_code)
+                        confirm_text(&f::ALARM_CONFIRM_CODES[..], confirm_code)
                     )
                 }
                 Ok(other) => format!(

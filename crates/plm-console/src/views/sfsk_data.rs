@@ -6,7 +6,7 @@
 use super::network::send;
 use super::seconds;
 use super::widgets::{button, note, set_checked, set_value, signal, text_input, text_table};
-use crate::network::{address_text, named};
+use crate::network::{address_text, confirm_text};
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::st7570::fields::{self as f, P_SDU_LEN};
@@ -112,7 +112,7 @@ fn SendCard() -> impl IntoView {
         send(c, command, move |r| {
             result.set(Some(match r {
                 Ok(Command::DataConfirm { confirm_code }) => {
-                    format!("CMD_DataConfirm: {}", named(table, confirm_code))
+                    format!("CMD_DataConfirm: {}", confirm_text(table, confirm_code))
                 }
                 Ok(other) => format!(
                     "answered {}",

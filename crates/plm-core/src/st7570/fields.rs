@@ -69,6 +69,24 @@ pub static MAC_CONFIRM_CODES: [&str; 256] = sparse_names(&[
     (0x06, "LM_NOT_VALID"),
     (0xFF, "LM_OK"),
 ]);
+/// What a CONFIRM_CODE of CMD_DataConfirm (Table 43) or CMD_AlarmConfirm
+/// (Table 48) means, by its name in those tables; `None` for LP_OK and
+/// LM_OK, which need no words.
+pub fn confirm_meaning(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "LP_TU" => "the modem's PHY layer is busy (another transmission pending or in progress, or outside the acceptance window): send again",
+        "LM_TU" => "the MAC layer is busy: send again",
+        "LM_NI" => "type not available",
+        "LP_HF" => "error at the physical level",
+        "LM_SE" => "length not correct on the data request",
+        "LP_NS" | "LM_NS" => "the modem is not synchronized",
+        "LP_IS" | "LM_IS" => "the modem is in Intelligent Synchronization search",
+        "LP_NOT_VALID" => "no data request pending, or error at the physical layer",
+        "LM_NOT_VALID" => "no data request pending",
+        _ => return None,
+    })
+}
+
 /// CONFIRM_CODE of CMD_AlarmConfirm (Table 48).
 pub static ALARM_CONFIRM_CODES: [&str; 256] = sparse_names(&[
     (0x00, "LP_TU"),
