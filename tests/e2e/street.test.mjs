@@ -87,7 +87,18 @@ test('dim one lamp and see its power follow; dim all by broadcast', async (t) =>
   const before3 = await number(page, 3, 'power');
   await row(page, 3).click();
   await page.locator('#lamp-panel h3', { hasText: lamp(3) }).waitFor();
-  await page.fill('#lamp-dim-level', '20');
+  // Typing in the lamp's page goes on while the lamp is read meanwhile
+  // (its state and plots are redrawn, the forms are not).
+  await page.fill('#lamp-dim-level', '');
+  await page.focus('#lamp-dim-level');
+  await page.keyboard.type('2');
+  const state = await page.locator('#lamp-panel figure.spark polyline').first().getAttribute('points');
+  await page.evaluate(() => document.querySelector('#lamp-read').click());
+  await page.locator('#lamp-note', { hasText: 'read: done' }).waitFor({ timeout: 30_000 });
+  await page.waitForFunction((was) => document.querySelector('#lamp-panel figure.spark polyline').getAttribute('points') !== was, state);
+  await page.keyboard.type('0');
+  assert.equal(await page.inputValue('#lamp-dim-level'), '20');
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'lamp-dim-level');
   await page.click('#lamp-dim');
   await page.waitForFunction(
     ([sel, was]) => Number(document.querySelector(sel)?.textContent) < was,

@@ -3,7 +3,7 @@
 //! ballast reset, and on a simulated street the faults a demo needs.
 
 use super::street::{computer_clock, dimming_value};
-use super::widgets::{button, on_event, signal, text_input};
+use super::widgets::{button, escape, html, on_event, signal, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
 use leptos::prelude::*;
@@ -65,6 +65,48 @@ fn sparkline(points: &[(u64, f64)]) -> (String, String) {
         line,
         format!("{}…{}", super::fixed(lo, 0), super::fixed(hi, 0)),
     )
+}
+
+/// What the street knows of a lamp, as HTML: its state, and its history
+/// plotted (power, temperature, SNR). Redrawn as the lamp is read, apart
+/// from the page's forms, so that typing in them goes on undisturbed.
+fn state_html(lamp: Option<&crate::street::Lamp>) -> String {
+    let Some(l) = lamp else {
+        return "<p class=\"muted\">This lamp is not on the street any more.</p>".into();
+    };
+    let state = match (&l.unreachable, l.state()) {
+        (Some(u), Some(s)) => format!("Unreachable: {u}. Last read: {s}."),
+        (Some(u), None) => format!("Unreachable: {u}."),
+        (None, Some(s)) => format!("Lamp {s}"),
+        (None, None) => "Not read yet.".to_string(),
+    };
+    let mut html = format!(
+        "<p{}>{}</p>",
+        if l.in_trouble() {
+            " class=\"problem\""
+        } else {
+            ""
+        },
+        escape(&state)
+    );
+    let series = |f: fn(&crate::street::Sample) -> Option<f64>| {
+        let pts: Vec<(u64, f64)> = l
+            .history
+            .iter()
+            .filter_map(|s| f(s).map(|v| (s.at, v)))
+            .collect();
+        sparkline(&pts)
+    };
+    for (name, (line, range)) in [
+        ("Power W", series(|s| Some(s.power as f64))),
+        ("Temperature °C", series(|s| Some(s.temperature as f64))),
+        ("SNR dB", series(|s| s.snr.map(f64::from))),
+    ] {
+        html.push_str(&format!(
+            "<figure class=\"spark\"><figcaption>{name} {range}</figcaption><svg viewBox=\"0 0 300 60\" preserveAspectRatio=\"none\"><polyline points=\"{line}\"/></svg></figure>"
+        ));
+    }
+    html
 }
 
 /// The page of the lamp `focus` names.
@@ -131,37 +173,13 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     };
     view! {
         <aside class="details lamp" id="lamp-panel">
-            {move || match lamp.get() {
-                None => view! { <p class="muted">"This lamp is not on the street any more."</p> }.into_any(),
-                Some(l) => {
-                    let series = |f: fn(&crate::street::Sample) -> Option<f64>| {
-                        let pts: Vec<(u64, f64)> = l.history.iter().filter_map(|s| f(s).map(|v| (s.at, v))).collect();
-                        sparkline(&pts)
-                    };
-                    let plots = [
-                        ("Power W", series(|s| Some(s.power as f64))),
-                        ("Temperature °C", series(|s| Some(s.temperature as f64))),
-                        ("SNR dB", series(|s| s.snr.map(f64::from))),
-                    ];
-                    view! {
+            // Rebuilt when another lamp is chosen; its state as it is read.
+            {move || focus.get().map(|address| view! {
                         <div class="lamp-head">
-                            <h3>{format!("Lamp {}", l.address)}</h3>
+                            <h3>{format!("Lamp {address}")}</h3>
                             {button("lamp-close", "✕", "close this lamp's page", move || focus.set(None))}
                         </div>
-                        <p class:problem=l.in_trouble()>
-                            {match (&l.unreachable, l.state()) {
-                                (Some(u), Some(s)) => format!("Unreachable: {u}. Last read: {s}."),
-                                (Some(u), None) => format!("Unreachable: {u}."),
-                                (None, Some(s)) => format!("Lamp {s}"),
-                                (None, None) => "Not read yet.".to_string(),
-                            }}
-                        </p>
-                        {plots.into_iter().map(|(name, (line, range))| view! {
-                            <figure class="spark">
-                                <figcaption>{format!("{name} {range}")}</figcaption>
-                                <svg viewBox="0 0 300 60" preserveAspectRatio="none"><polyline points=line/></svg>
-                            </figure>
-                        }).map(IntoAny::into_any).collect_view()}
+                        {html(Box::new(move || lamp.with(|l| state_html(l.as_ref()))))}
                         <div class="form-row">
                             {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
                             <label>
@@ -229,9 +247,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             </div>
                         }).map(IntoAny::into_any)}
                         {super::widgets::note("lamp-note", "muted", note)}
-                    }.into_any()
-                }
-            }}
+            }.into_any())}
         </aside>
     }
 }
