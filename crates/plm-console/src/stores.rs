@@ -576,9 +576,9 @@ impl Console {
     /// Lets time pass up to the page's clock, then asks to be run again
     /// when something is next due ([`crate::wake`]).
     pub fn tick(&self) {
-        // A busy line's notes were drawn since the last tick, and the line
-        // waits: the page lays them out now rather than while a frame may
-        // be ending ([`crate::session::Session::holds_line`]).
+        // Notes were handed out since the last tick, and the line waits:
+        // the page lays them out now rather than while a frame may be
+        // ending ([`crate::session::Session::holds_line`]).
         if self.session().borrow().drawing() {
             crate::wake::lay_out();
         }
