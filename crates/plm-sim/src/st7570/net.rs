@@ -12,7 +12,7 @@
 
 use super::drive::{ModemDriver, Outcome};
 use super::line::{self, SfskLine, Signal};
-use super::responder::Responder;
+use super::responder::{PhySettings, Responder};
 use super::slots::{SlotUse, Transmission, FRAME_BITS};
 use super::St7570;
 use crate::ports::Ports;
@@ -74,6 +74,10 @@ pub struct NetConfig {
     /// [`Ports`]); the others' hosts are a [`Responder`] or plm-core's
     /// host engine driven by a test.
     pub served: usize,
+    /// The [`Responder`] Servers take on node 0's bit rate, f0 and f1
+    /// (00A1h) whenever they change ([`Responder::follow`]); otherwise
+    /// they keep the factory ones.
+    pub servers_follow: bool,
 }
 
 /// Nodes of a served network unless told otherwise: the host's modem and
@@ -88,11 +92,13 @@ impl NetConfig {
     /// The network `plm sim --chip st7570` and the console's simulated
     /// ST7570 serve: nodes 0..`served` driven from outside, the others
     /// Servers at their node number that answer what is sent to them
-    /// ([`Responder`]), every [`REPEATER_EVERY`]-th a repeater.
+    /// ([`Responder`]), every [`REPEATER_EVERY`]-th a repeater, taking on
+    /// node 0's bit rate, f0 and f1 ([`NetConfig::servers_follow`]).
     pub fn served_line(nodes: usize, served: usize, seed: u64) -> Self {
         NetConfig {
             seed,
             served,
+            servers_follow: true,
             responders: (served..nodes)
                 .map(|i| (i, i % REPEATER_EVERY == 0))
                 .collect(),
@@ -119,6 +125,7 @@ impl NetConfig {
             responders: Vec::new(),
             timeout_scale: 1,
             served: 0,
+            servers_follow: false,
         }
     }
 }
@@ -136,6 +143,9 @@ pub struct Network {
     due: Vec<Due>,
     /// Subframe slots sent with differing contents heard by someone.
     pub collisions: u64,
+    servers_follow: bool,
+    /// Node 0's PHY settings as last given to the Servers.
+    followed: Option<PhySettings>,
 }
 
 impl Network {
@@ -172,6 +182,8 @@ impl Network {
             on_air: Vec::new(),
             due: Vec::new(),
             collisions: 0,
+            servers_follow: config.servers_follow,
+            followed: None,
         };
         for i in 0..net.nodes.len() {
             net.refresh_node(i);
@@ -260,6 +272,7 @@ impl Network {
     ) -> bool {
         let end = self.now + limit;
         loop {
+            self.follow_node_0();
             for i in 0..self.nodes.len() {
                 self.after_step(i);
                 let n = &mut self.nodes[i];
@@ -297,6 +310,26 @@ impl Network {
             .map(|n| n.driver.next_due())
             .chain(self.due.iter().map(|d| Some(due_at(d))))
             .fold(None, earliest)
+    }
+
+    /// [`NetConfig::servers_follow`]: node 0's bit rate, f0 and f1, when
+    /// they changed (its host wrote 00A1h, or a reset brought the factory
+    /// values back), given to every Responder Server, whose host then
+    /// writes them to its modem.
+    fn follow_node_0(&mut self) {
+        if !self.servers_follow || self.nodes.is_empty() {
+            return;
+        }
+        let phy = PhySettings::of(&self.modem(0).mib().plc());
+        if self.followed == Some(phy) {
+            return;
+        }
+        self.followed = Some(phy);
+        for n in &mut self.nodes[1..] {
+            if let Some(r) = n.responder.as_mut() {
+                r.follow(phy);
+            }
+        }
     }
 
     /// Node `i`'s RESETn held low (`true`) or released: as a host wiring

@@ -7,6 +7,10 @@
 //! M_SDU starting with `?` draws `!` and the node's address and the
 //! delta-phase it measured (000Eh), anything else is echoed. Answers go to
 //! the sender with the IC the request came with (the way back is as long).
+//!
+//! Its 00A1h is the factory one made a MAC Server, with the Client's bit
+//! rate, f0 and f1 once the network tells it ([`Responder::follow`],
+//! docs/protocol-notes.md "ST7570: simulated network").
 
 use super::drive::ModemDriver;
 use super::mode;
@@ -38,6 +42,43 @@ pub struct Responder {
     /// (A list: it runs in the console's page too, where a `VecDeque` of
     /// its own item type would bring its own code.)
     pub syncs: Vec<(Instant, MacSync)>,
+    /// The 00A1h it gives its modem.
+    plc: PlcConfiguration,
+}
+
+/// The PHY settings of 00A1h (Table 137) a Server takes on from the
+/// Client: bit rate, f0 and f1. The mains frequency is the line's, the
+/// gain and current limiting each modem's own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PhySettings {
+    /// 2400 bit/s rather than 1200.
+    pub bit_rate_2400: bool,
+    /// f0 in Hz.
+    pub f0: u32,
+    /// f1 in Hz.
+    pub f1: u32,
+}
+
+impl PhySettings {
+    /// Those of `plc`.
+    pub fn of(plc: &PlcConfiguration) -> Self {
+        PhySettings {
+            bit_rate_2400: plc.bit_rate_2400,
+            f0: plc.f0,
+            f1: plc.f1,
+        }
+    }
+
+    /// `plc` with these.
+    fn apply(self, plc: &mut PlcConfiguration) {
+        plc.bit_rate_2400 = self.bit_rate_2400;
+        plc.f0 = self.f0;
+        plc.f1 = self.f1;
+    }
+}
+
+fn write(index: u16, data: Vec<u8>) -> Command {
+    Command::WriteDbRequest { index, data }
 }
 
 impl Responder {
@@ -48,7 +89,6 @@ impl Responder {
         plc.operating_mode = mode::SERVER;
         plc.access_layer_mode = Layer::Mac.access_layer_mode();
         let mut queue = VecDeque::new();
-        let write = |index: u16, data: Vec<u8>| Command::WriteDbRequest { index, data };
         queue.push_back(write(index::PLC_CONFIGURATION, plc.encode()));
         let mut local = address.to_le_bytes().to_vec();
         local.extend_from_slice(&[0, 0]);
@@ -63,7 +103,23 @@ impl Responder {
             indicated: 0,
             answered: 0,
             syncs: Vec::new(),
+            plc,
         }
+    }
+
+    /// Takes on the Client's bit rate, f0 and f1: if they differ from
+    /// those it gave its modem, its 00A1h with them is written before
+    /// anything else it has to send (replacing one not sent yet).
+    pub fn follow(&mut self, phy: PhySettings) {
+        if PhySettings::of(&self.plc) == phy {
+            return;
+        }
+        phy.apply(&mut self.plc);
+        self.queue.retain(|c| {
+            !matches!(c, Command::WriteDbRequest { index: i, .. } if *i == index::PLC_CONFIGURATION)
+        });
+        self.queue
+            .push_front(write(index::PLC_CONFIGURATION, self.plc.encode()));
     }
 
     /// Has its modem send an alarm (CMD_AlarmRequest, 5.3.15) once the
