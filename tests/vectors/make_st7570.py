@@ -17,10 +17,13 @@ expect: one entry per element: kind (frame|status), for frames code,
 command, checksum, checksum_ok, fields (by the manual's labels in
 snake_case: numbers, enum names, bytes as hex, flags as booleans) and for
 MIB data "object" (the fields of the object's value); for status messages
-row and fields.
+row and fields. Estimations are in the manual's units (3.6.1): S0..N1, S,
+N, AL_* and thresholds in dBuV (Equation 1, value / 100), SNR0/SNR1 in dB
+(Equation 2), each with the raw number beside it as NAME_raw.
 Run: python3 tests/vectors/make_st7570.py > tests/vectors/st7570.jsonl
 """
 import json
+import math
 
 
 def frame(code, data=b""):
@@ -36,6 +39,41 @@ def hx(s):
 def le(v, n):
     return v.to_bytes(n, "little")
 
+
+def dbuv(raw):
+    """3.6.1, Equation 1: V_RMS [dBuV] = value / 100."""
+    return round(raw / 100, 2)
+
+
+def snr_db(raw):
+    """3.6.1, Equation 2: SNR [dB] = 10 * 64 * value * log10(2) * 2^-19."""
+    return round(10 * 64 * raw * math.log10(2) / 2 ** 19, 3)
+
+
+def in_dbuv(**raws):
+    """Fields in dBuV with the raw number beside each."""
+    out = {}
+    for k, raw in raws.items():
+        out[k] = dbuv(raw)
+        out[k + "_raw"] = raw
+    return out
+
+
+def in_db(**raws):
+    """SNR fields in dB with the raw number beside each."""
+    out = {}
+    for k, raw in raws.items():
+        out[k] = snr_db(raw)
+        out[k + "_raw"] = raw
+    return out
+
+
+# 3.6.1 Table 3 and section 9 as printed: the equations give the manual's
+# own numbers (S1 of 9 step 2 excepted, see its quirk).
+assert [dbuv(r) for r in (0x2C8F, 0x2359, 0x2B0C, 0x23F6)] == [114.07, 90.49, 110.20, 92.06]
+assert [dbuv(r) for r in (0x19F6, 0x1104, 0x0FB6)] == [66.46, 43.56, 40.22]
+assert (snr_db(0x10913), snr_db(0xFD33)) == (24.936, 23.819)
+assert [dbuv(r) for r in (0x28DF, 0x1722, 0x2903, 0x16B0)] == [104.63, 59.22, 104.99, 58.08]
 
 V = []
 
@@ -80,19 +118,22 @@ v("9 step 1 CMD_DataRequest, P_SDU 00h..25h", "ST7570 UM 9 step 1", "host", "phy
 # Step 2 as printed: its checksum 4A.02h is wrong (the sum is 0247h).
 step2 = hx("02 11 10 F6.19.00 04.11.00 1A.1A.00 B6.0F.00 08 01 4A.02")
 assert frame(0x10, step2[3:-2])[-2:] == hx("47 02")
-sync_fields = {"s0": 0x19F6, "n0": 0x1104, "s1": 0x1A1A, "n1": 0x0FB6, "pga": 8, "phase": "0°"}
+# 9 step 2 reads S0 66.46, N0 43.56, S1 "71.848" (Equation 1: 66.82), N1 40.22 dBuV.
+sync_fields = dict(in_dbuv(s0=0x19F6, n0=0x1104, s1=0x1A1A, n1=0x0FB6), pga=8, phase="0°")
+assert (sync_fields["s0"], sync_fields["s1"]) == (66.46, 66.82)
 v("9 step 2 CMD_SynchroIndication as printed (wrong checksum)", "ST7570 UM 9 step 2", "modem", "phy", step2,
   [F(0x10, "CMD_SynchroIndication", sync_fields, ok=False, checksum=0x024A)],
   quirk="the printed checksum 4A.02h is wrong: Length..data sum to 0247h; the text also gives S1 1A1Ah = 6682 "
-        "as 71.848 dBuV instead of 66.82")
+        "as 71.848 dBuV where Equation 1 gives 66.82 (the vector expects 66.82)")
 v("9 step 2 CMD_SynchroIndication with its checksum corrected", "ST7570 UM 9 step 2", "modem", "phy",
   frame(0x10, step2[3:-2]), [F(0x10, "CMD_SynchroIndication", sync_fields, checksum=0x0247)])
 step3 = hx("02 35 50") + P_SDU + hx("A9.00 5D.00 2A.00 13.09.01 33.FD.00 C1.05")
 assert step3 == frame(0x50, step3[3:-2])
-v("9 step 3 CMD_DataIndication: ASK0 169, ASK1 93, FSK 42, SNR0 10913h, SNR1 FD33h", "ST7570 UM 9 step 3",
+v("9 step 3 CMD_DataIndication: ASK0 169, ASK1 93, FSK 42, SNR0 24.936 dB, SNR1 23.819 dB", "ST7570 UM 9 step 3",
   "modem", "phy", step3,
-  [F(0x50, "CMD_DataIndication", {"p_sdu": P_SDU.hex(), "ask0": 169, "ask1": 93, "fsk": 42,
-                                  "snr0": 0x10913, "snr1": 0xFD33}, checksum=0x05C1)])
+  [F(0x50, "CMD_DataIndication", dict({"p_sdu": P_SDU.hex(), "ask0": 169, "ask1": 93, "fsk": 42},
+                                      **in_db(snr0=0x10913, snr1=0xFD33)), checksum=0x05C1)],
+  quirk="the text gives the SNRs in 'dBuV RMS'; Equation 2 gives dB")
 v("9 step 4 CMD_DataConfirm LP_OK", "ST7570 UM 9 step 4", "modem", "phy", hx("02 04 52 FF 55.01"),
   [F(0x52, "CMD_DataConfirm", {"confirm_code": "LP_OK"}, checksum=0x0155)])
 
@@ -137,8 +178,8 @@ v("10.3.1 Station1 CMD_DataRequest: SA C00h, DA 001h, IC=CC=DC=0", "ST7570 UM 10
 s = hx("02 12 10 01") + bytes(14) + hx("23 00")
 assert s == frame(0x10, s[3:-2])
 v("10.3.1 Station1 CMD_SynchroIndication FOUND, no estimation", "ST7570 UM 10.3.1", "modem", "mac", s,
-  [F(0x10, "CMD_SynchroIndication", {"sync": "FOUND", "s0": 0, "n0": 0, "s1": 0, "n1": 0, "pga": 0,
-                                      "phase": "Not valid"}, checksum=0x0023)])
+  [F(0x10, "CMD_SynchroIndication", dict({"sync": "FOUND", "pga": 0, "phase": "Not valid"},
+                                          **in_dbuv(s0=0, n0=0, s1=0, n1=0)), checksum=0x0023)])
 v("10.3.1 Station1 CMD_DataConfirm LM_OK", "ST7570 UM 10.3.1", "modem", "mac", hx("02 04 52 FF 55.01"),
   [F(0x52, "CMD_DataConfirm", {"confirm_code": "LM_OK"}, checksum=0x0155)],
   quirk="the text names FFh LP_OK; Table 43 names it LM_OK in MAC mode")
@@ -148,7 +189,7 @@ s = frame(0x10, bytes([1]) + le(0x28DF, 3) + le(0x1722, 3) + le(0x2903, 3) + le(
 assert s[-2:] == hx("5A 02")
 v("10.3.2 Station2 CMD_SynchroIndication FOUND: S0 104.63, N0 59.22, S1 104.99, N1 58.08 dBuV",
   "ST7570 UM 10.3.2", "modem", "mac", s,
-  [F(0x10, "CMD_SynchroIndication", {"sync": "FOUND", "s0": 10463, "n0": 5922, "s1": 10499, "n1": 5808,
+  [F(0x10, "CMD_SynchroIndication", {"sync": "FOUND", **in_dbuv(s0=10463, n0=5922, s1=10499, n1=5808),
                                       "pga": 4, "phase": "0°"}, checksum=0x025A)])
 i = hx("02 22 50 00 C0.00.01 00") + M_SDU + hx("78.02")
 assert i == frame(0x50, i[3:-2])
@@ -187,9 +228,9 @@ defaults = [
     (0x0009, "0000", {"timeout_intelligent_synchronization": 0}),
     (0x000A, "00" * 4, {"valid_frame_counter": 0}),
     (0x000B, "00", {"repeater_settings": "NEVER_REPEAT", "tic_selector": "5 characters"}),
-    (0x000C, "a0280000", {"rc_threshold": 0x28A0, "pad": 0}),
-    (0x000D, "00" * 10, {"s0": 0, "n0": 0, "pga": 0}),
-    (0x000E, "00" * 10, {"s1": 0, "n1": 0, "phase": 0}),
+    (0x000C, "a0280000", {**in_dbuv(rc_threshold=0x28A0), "pad": 0}),
+    (0x000D, "00" * 10, {**in_dbuv(s0=0, n0=0), "pga": 0}),
+    (0x000E, "00" * 10, {**in_dbuv(s1=0, n1=0), "phase": 0}),
     (0x000F, "00" * 4, {"transmitted_frame_counter": 0}),
     (0x0010, "00" * 4, {"repeated_frame_counter": 0}),
     (0x0011, "00" * 4, {"bad_frame_indicator_counter": 0}),
@@ -197,7 +238,7 @@ defaults = [
     (0x0013, "00", {"smart_phase_detect": "SMART_DISABLED"}),
     (0x0014, "00", {"phase": 0}),
     (0x0015, "00", {"auto_synchro_reject": "disabled"}),
-    (0x0016, "ffffff0f", {"is_threshold": 0x0FFFFFFF}),
+    (0x0016, "ffffff0f", in_dbuv(is_threshold=0x0FFFFFFF)),
     (0x0082, "001010", {"current_limiting": "disabled", "target_output_gain": 16, "actual_output_gain": 16}),
     (0x0083, "00" * 4, {"received_alarm_counter": 0}),
     (0x0084, "00" * 4, {"transmitted_alarm_counter": 0}),
@@ -235,7 +276,7 @@ v("MIB 0082h confirm", "ST7570 UM 6.5.24, Table 123", "modem", "mac", frame(0x42
 # ------------------------------------------------ one frame per layout
 v("PHY CMD_SynchroIndication with Table 3's estimations", "ST7570 UM Tables 3, 17", "modem", "phy",
   frame(0x10, le(0x2C8F, 3) + le(0x2359, 3) + le(0x2B0C, 3) + le(0x23F6, 3) + bytes([2, 6])),
-  [F(0x10, "CMD_SynchroIndication", {"s0": 0x2C8F, "n0": 0x2359, "s1": 0x2B0C, "n1": 0x23F6, "pga": 2,
+  [F(0x10, "CMD_SynchroIndication", {**in_dbuv(s0=0x2C8F, n0=0x2359, s1=0x2B0C, n1=0x23F6), "pga": 2,
                                       "phase": "-60°"})])
 v("MAC SYNC CONFIRMED by a frame C00h -> 001h", "ST7570 UM Table 18", "modem", "mac",
   frame(0x10, bytes([2, 0]) + le(0xC00, 2) + le(0x001, 2)),
@@ -249,7 +290,7 @@ for cause, cname in [(1, "Timeout not addressed expired"), (2, "Timeout frame no
 for cause, cname in [(6, "LM_IS_INIT"), (7, "LM_IS_SYNC_FAST"), (8, "LM_IS_NOT_INIT")]:
     v(f"MAC SYNC INTELLIGENT {cname}", "ST7570 UM Table 18", "modem", "mac",
       frame(0x10, bytes([5, cause]) + le(0xC01, 2) + le(0x2968, 2)),
-      [F(0x10, "CMD_SynchroIndication", {"sync": "INTELLIGENT", "cause": cname, "add": 0xC01, "s": 0x2968})])
+      [F(0x10, "CMD_SynchroIndication", {"sync": "INTELLIGENT", "cause": cname, "add": 0xC01, **in_dbuv(s=0x2968)})])
 v("CMD_DesynchroRequest", "ST7570 UM Table 22", "host", "mac", frame(0x11, b"\x01"),
   [F(0x11, "CMD_DesynchroRequest", {"reset": "Rejects current synchronization"})])
 v("CMD_SynchroStatus request and answers", "ST7570 UM Tables 19-20", "modem", "phy",
@@ -283,15 +324,15 @@ v("CMD_AlarmIndication short", "ST7570 UM Table 45", "modem", "phy", frame(0x8A,
   [F(0x8A, "CMD_AlarmIndication", {"cnt": 2})])
 v("CMD_AlarmIndication long", "ST7570 UM Table 45", "modem", "mac",
   frame(0x8A, le(10, 4) + le(11407, 3) + le(9049, 3) + le(11020, 3) + le(9206, 3) + b"\x00"),
-  [F(0x8A, "CMD_AlarmIndication", {"cnt": 10, "s0": 11407, "n0": 9049, "s1": 11020, "n1": 9206, "pad": 0})])
+  [F(0x8A, "CMD_AlarmIndication", {"cnt": 10, **in_dbuv(s0=11407, n0=9049, s1=11020, n1=9206), "pad": 0})])
 sn = le(0x2C8F, 3) + le(0x2359, 3) + le(0x2B0C, 3) + le(0x23F6, 3)
-snf = {"s0": 0x2C8F, "n0": 0x2359, "s1": 0x2B0C, "n1": 0x23F6}
+snf = in_dbuv(s0=0x2C8F, n0=0x2359, s1=0x2B0C, n1=0x23F6)
 v("SPY_No_SubframeIndication", "ST7570 UM Table 50", "modem", "phy", frame(0xA0, sn + bytes(58)),
   [F(0xA0, "SPY_No_SubframeIndication", dict(snf, pad="00" * 58))])
 v("SPY_SubframeIndication", "ST7570 UM Table 52", "modem", "phy",
   frame(0xB0, sn + le(169, 2) + le(93, 2) + le(42, 2) + b"\x05" + P_SDU + le(0x10913, 3) + le(0xFD33, 3)),
   [F(0xB0, "SPY_SubframeIndication", dict(snf, ask0=169, ask1=93, fsk=42, pga=5, p_sdu=P_SDU.hex(),
-                                          snr0=0x10913, snr1=0xFD33))])
+                                          **in_db(snr0=0x10913, snr1=0xFD33)))])
 v("SPY_SearchSynchroIndication", "ST7570 UM Table 53", "modem", "phy", frame(0xC0),
   [F(0xC0, "SPY_SearchSynchroIndication", {}, checksum=0x00C3)])
 v("SPY_SynchroFoundIndication", "ST7570 UM Table 55", "modem", "phy",
@@ -300,19 +341,20 @@ v("SPY_SynchroFoundIndication", "ST7570 UM Table 55", "modem", "phy",
 for code, cname in [(0xE0, "SPY_No_AlarmIndication"), (0xF0, "SPY_AlarmIndication")]:
     v(f"{cname} with the alarm pattern 569E89h", "ST7570 UM Tables 57, 59", "modem", "phy",
       frame(code, sn + bytes(7) + hx("56 9E 89")),
-      [F(code, cname, {"al_s0": 0x2C8F, "al_n0": 0x2359, "al_s1": 0x2B0C, "al_n1": 0x23F6, "pad": "00" * 7,
+      [F(code, cname, {**in_dbuv(al_s0=0x2C8F, al_n0=0x2359, al_s1=0x2B0C, al_n1=0x23F6), "pad": "00" * 7,
                        "alarm": 0x569E89})])
 v("CMD_RC_Request from the MIB (both zero) and explicit", "ST7570 UM Table 61", "host", "mac",
   frame(0x61, bytes(4)) + frame(0x61, le(21, 2) + le(0x28A0, 2)),
-  [F(0x61, "CMD_RC_Request", {"tx_pos": 0, "rc_threshold": 0}),
-   F(0x61, "CMD_RC_Request", {"tx_pos": 21, "rc_threshold": 0x28A0})])
+  [F(0x61, "CMD_RC_Request", {"tx_pos": 0, **in_dbuv(rc_threshold=0)}),
+   F(0x61, "CMD_RC_Request", {"tx_pos": 21, **in_dbuv(rc_threshold=0x28A0)})])
 v("CMD_RC_Confirm refused, NEVER_REPEAT", "ST7570 UM Table 63", "modem", "mac", frame(0x62, hx("06 00")),
   [F(0x62, "CMD_RC_Confirm", {"result": "LP_NOT_VALID", "repeater_state": "NEVER_REPEAT"})])
 v("CMD_RC_Confirm Server LP_OK with the pattern heard", "ST7570 UM Table 63", "modem", "mac",
   frame(0x62, hx("FF 03") + le(10463, 3) + le(5922, 3) + le(7, 2)),
-  [F(0x62, "CMD_RC_Confirm", {"result": "LP_OK", "repeater_state": "REPEAT", "s": 10463, "n": 5922, "rx_pos": 7})])
+  [F(0x62, "CMD_RC_Confirm", {"result": "LP_OK", "repeater_state": "REPEAT", **in_dbuv(s=10463, n=5922),
+                              "rx_pos": 7})])
 v("CMD_IS_Indication LM_LOCKED", "ST7570 UM Table 65", "modem", "mac", frame(0x15, b"\x01" + le(0xC00, 2) + le(10600, 2)),
-  [F(0x15, "CMD_IS_Indication", {"is_status": "LM_LOCKED", "add": 0xC00, "s": 10600})])
+  [F(0x15, "CMD_IS_Indication", {"is_status": "LM_LOCKED", "add": 0xC00, **in_dbuv(s=10600)})])
 for st, name in [(2, "LM_NOT_LOCKED"), (3, "LM_NOT_REGISTERED"), (4, "LM_TO_NOT_ADDRESSED")]:
     v(f"CMD_IS_Indication {name}", "ST7570 UM Table 65", "modem", "mac", frame(0x15, bytes([st])),
       [F(0x15, "CMD_IS_Indication", {"is_status": name})])

@@ -49,11 +49,21 @@ const TABLE_3: [u8; 12] = [
 
 fn table_3(prefix: &str) -> Value {
     json!({
-        format!("{prefix}s0"): 11407,
-        format!("{prefix}n0"): 9049,
-        format!("{prefix}s1"): 11020,
-        format!("{prefix}n1"): 9206,
+        format!("{prefix}s0"): 114.07,
+        format!("{prefix}s0_raw"): 11407,
+        format!("{prefix}n0"): 90.49,
+        format!("{prefix}n0_raw"): 9049,
+        format!("{prefix}s1"): 110.20,
+        format!("{prefix}s1_raw"): 11020,
+        format!("{prefix}n1"): 92.06,
+        format!("{prefix}n1_raw"): 9206,
     })
+}
+
+/// SNR0 and SNR1 of 9 step 3 in dB (3.6.1, Equation 2: 24.936 and 23.819,
+/// as section 9 prints them), with the raw numbers.
+fn snr_9_3() -> Value {
+    json!({"snr0": 24.936, "snr0_raw": 0x10913, "snr1": 23.819, "snr1_raw": 0xFD33})
 }
 
 /// `a` with the members of `b` added.
@@ -142,7 +152,11 @@ fn cases() -> Vec<Case> {
             "phy",
             "modem",
             "021110f619000411001a1a00b60f0008014702".into(),
-            json!({"s0": 6646, "n0": 4356, "s1": 6682, "n1": 4022, "pga": 8, "phase": "0°"}),
+            // S0 66.46, N0 43.56, S1 66.82 (the text's "71.848" is not
+            // Equation 1's), N1 40.22 dBµV.
+            json!({"s0": 66.46, "s0_raw": 6646, "n0": 43.56, "n0_raw": 4356,
+                   "s1": 66.82, "s1_raw": 6682, "n1": 40.22, "n1_raw": 4022,
+                   "pga": 8, "phase": "0°"}),
         ),
         // 10.3.2.
         case(
@@ -150,7 +164,8 @@ fn cases() -> Vec<Case> {
             "mac",
             "modem",
             "02121001df2800221700032900b0160004015a02".into(),
-            json!({"sync": "FOUND", "s0": 10463, "n0": 5922, "s1": 10499, "n1": 5808, "pga": 4, "phase": "0°"}),
+            json!({"sync": "FOUND", "s0": 104.63, "s0_raw": 10463, "n0": 59.22, "n0_raw": 5922,
+                   "s1": 104.99, "s1_raw": 10499, "n1": 58.08, "n1_raw": 5808, "pga": 4, "phase": "0°"}),
         ),
         case(
             "MAC CMD_SynchroIndication CONFIRMED",
@@ -178,7 +193,7 @@ fn cases() -> Vec<Case> {
             "mac",
             "modem",
             frame(0x10, &[0x05, 0x06, 0x00, 0x0C, 0x68, 0x29]),
-            json!({"sync": "INTELLIGENT", "cause": "LM_IS_INIT", "add": 0xC00, "s": 10600}),
+            json!({"sync": "INTELLIGENT", "cause": "LM_IS_INIT", "add": 0xC00, "s": 106.00, "s_raw": 10600}),
         ),
         case(
             "CMD_DesynchroRequest",
@@ -271,7 +286,7 @@ fn cases() -> Vec<Case> {
             "modem",
             "023550000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f202122232425a9005d002a0013090133fd00c105".into(),
             with(
-                json!({"p_sdu": hex(&p_sdu()), "snr0": 0x10913, "snr1": 0xFD33}),
+                with(json!({"p_sdu": hex(&p_sdu())}), snr_9_3()),
                 counters.clone(),
             ),
         ),
@@ -370,7 +385,7 @@ fn cases() -> Vec<Case> {
             frame(0xB0, &spy_subframe),
             with(
                 with(table_3(""), counters.clone()),
-                json!({"pga": 3, "p_sdu": hex(&p_sdu()), "snr0": 0x10913, "snr1": 0xFD33}),
+                with(json!({"pga": 3, "p_sdu": hex(&p_sdu())}), snr_9_3()),
             ),
         ),
         case(
@@ -406,7 +421,7 @@ fn cases() -> Vec<Case> {
             "mac",
             "host",
             frame(0x61, &[0x03, 0x00, 0x68, 0x29]),
-            json!({"tx_pos": 3, "rc_threshold": 10600}),
+            json!({"tx_pos": 3, "rc_threshold": 106.00, "rc_threshold_raw": 10600}),
         ),
         case(
             "CMD_RC_Confirm short",
@@ -423,14 +438,15 @@ fn cases() -> Vec<Case> {
                 0x62,
                 &[0xFF, 0x03, 0x8F, 0x2C, 0x00, 0x59, 0x23, 0x00, 0x05, 0x00],
             ),
-            json!({"result": "LP_OK", "repeater_state": "REPEAT", "s": 11407, "n": 9049, "rx_pos": 5}),
+            json!({"result": "LP_OK", "repeater_state": "REPEAT", "s": 114.07, "s_raw": 11407,
+                   "n": 90.49, "n_raw": 9049, "rx_pos": 5}),
         ),
         case(
             "CMD_IS_Indication LM_LOCKED",
             "mac",
             "modem",
             frame(0x15, &[0x01, 0x00, 0x0C, 0x68, 0x29]),
-            json!({"is_status": "LM_LOCKED", "add": 0xC00, "s": 10600}),
+            json!({"is_status": "LM_LOCKED", "add": 0xC00, "s": 106.00, "s_raw": 10600}),
         ),
         case(
             "CMD_IS_Indication LM_NOT_REGISTERED",
@@ -699,7 +715,8 @@ fn the_printed_checksum_of_9_step_2_is_reported_not_refused() {
     );
     assert_eq!(lines[0]["checksum_ok"], false);
     assert_eq!(lines[0]["checksum"], 0x024A);
-    assert_eq!(fields(&lines[0])["s0"], 6646);
+    assert_eq!(fields(&lines[0])["s0"], 66.46);
+    assert_eq!(fields(&lines[0])["s0_raw"], 6646);
 }
 
 #[test]

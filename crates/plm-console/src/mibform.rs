@@ -119,12 +119,12 @@ pub fn input_text(field: &Field, data: &[u8]) -> String {
     }
 }
 
-/// A field's value in words, with its unit (`86000 Hz`, `Q-PSK`).
+/// A field's value in words, with its unit (`86000 Hz`, `Q-PSK`, `66.46
+/// dBµV`: [`Field::show`]).
 pub fn show(field: &Field, data: &[u8]) -> String {
     match field.read(data) {
         None => "–".to_string(),
-        Some(v) if field.unit.is_empty() || v.as_i64().is_none() => v.to_string(),
-        Some(v) => format!("{v} {}", field.unit),
+        Some(v) => field.show(&v),
     }
 }
 

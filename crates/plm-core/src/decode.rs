@@ -38,6 +38,7 @@ use crate::field::{Field, Value};
 use crate::hex;
 use crate::json::{json_record, Json, Object};
 use crate::link::{Dialect, Element, GarbageReason, LocalFrame, Source, StreamDecoder};
+use alloc::format;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
@@ -118,10 +119,23 @@ pub fn json_value(v: &Value) -> Json {
     }
 }
 
+/// One field's value in `map` under its name. A number the seed reads in
+/// a unit ([`Field::scale`]: S0 in dBµV) is given in that unit, and the
+/// raw number beside it as `NAME_raw`.
+pub(crate) fn put_value(map: &mut Object, f: &Field, v: &Value) {
+    match f.reading(v) {
+        Some(text) => {
+            map.insert(f.name, Json::Number(text));
+            map.insert(format!("{}_raw", f.name), json_value(v));
+        }
+        None => map.insert(f.name, json_value(v)),
+    }
+}
+
 /// The named values of `data` under `layout`, in `map`.
 pub(crate) fn put_layout(map: &mut Object, layout: &'static [Field], data: &[u8]) {
     for (f, v) in crate::mib::describe(layout, data) {
-        map.insert(f.name, json_value(&v));
+        put_value(map, f, &v);
     }
 }
 

@@ -68,6 +68,62 @@ pub struct Field {
     /// the same bytes holds this value (Table 39: SNR 255 has no meaning
     /// for FSK frames only; for PSK frames it is -1 dB).
     pub absent_if: Option<(&'static Field, i64)>,
+    /// How the seed reads the raw number in its unit (ST7570 UM 3.6.1:
+    /// S0 in dBµV is the raw value / 100); `None` when the number is read
+    /// as it is.
+    pub scale: Option<Scale>,
+}
+
+/// A raw number read in the seed's unit: `raw × factor` `unit`, given to
+/// `decimals` places (ST7570 UM 3.6.1, Equations 1 and 2).
+#[derive(Debug, Clone, Copy)]
+pub struct Scale {
+    /// The unit of the reading (`dBµV`, `dB`).
+    pub unit: &'static str,
+    /// The reading of one raw step.
+    pub factor: f64,
+    /// Decimal places the reading is given to (at most 9).
+    pub decimals: u8,
+}
+
+impl PartialEq for Scale {
+    fn eq(&self, other: &Scale) -> bool {
+        self.unit == other.unit
+            && self.factor.to_bits() == other.factor.to_bits()
+            && self.decimals == other.decimals
+    }
+}
+
+impl Eq for Scale {}
+
+impl Scale {
+    /// The reading of `raw`.
+    pub fn of(&self, raw: i64) -> f64 {
+        raw as f64 * self.factor
+    }
+
+    /// The reading of `raw` as decimal text with [`Scale::decimals`]
+    /// places, rounded half away from zero (`6646` at 0.01 is `66.46`).
+    /// Written out rather than through float formatting, which would cost
+    /// the console's wasm two algorithms and their tables.
+    pub fn text(&self, raw: i64) -> String {
+        let decimals = self.decimals.min(9) as u32;
+        let step = 10u64.pow(decimals);
+        let v = self.of(raw);
+        // Non-negative and below 2^53: `as` truncates, + 0.5 rounds.
+        let scaled = (if v < 0.0 { -v } else { v }) * step as f64 + 0.5;
+        let scaled = scaled as u64;
+        let sign = if v < 0.0 && scaled != 0 { "-" } else { "" };
+        match decimals {
+            0 => alloc::format!("{sign}{scaled}"),
+            d => alloc::format!(
+                "{sign}{}.{:0width$}",
+                scaled / step,
+                scaled % step,
+                width = d as usize
+            ),
+        }
+    }
 }
 
 /// A decoded field value.
@@ -156,6 +212,7 @@ impl Field {
             settable: true,
             absent: None,
             absent_if: None,
+            scale: None,
         }
     }
 
@@ -242,6 +299,13 @@ impl Field {
     /// The same field with a unit.
     pub const fn unit(mut self, unit: &'static str) -> Field {
         self.unit = unit;
+        self
+    }
+
+    /// The same field read in the seed's unit through `scale` (the raw
+    /// number keeps [`Field::unit`]).
+    pub const fn scaled(mut self, scale: Scale) -> Field {
+        self.scale = Some(scale);
         self
     }
 
@@ -352,6 +416,34 @@ impl Field {
                 Value::Enum { raw, name }
             }
         })
+    }
+
+    /// The reading of a number value in the seed's unit, as decimal text
+    /// ([`Scale::text`]); `None` for a field without a [`Scale`] and for
+    /// values that are not numbers.
+    pub fn reading(&self, v: &Value) -> Option<String> {
+        let scale = self.scale?;
+        match v {
+            Value::Uint(_) | Value::Int(_) => Some(scale.text(v.as_i64()?)),
+            _ => None,
+        }
+    }
+
+    /// The unit a value of this field is shown in: its [`Scale`]'s when
+    /// it has one, else [`Field::unit`].
+    pub fn shown_unit(&self) -> &'static str {
+        self.scale.map_or(self.unit, |s| s.unit)
+    }
+
+    /// A value of this field in words with its unit, for people: `66.46
+    /// dBµV` (a scaled number), `86000 Hz`, `Q-PSK`, `no value`.
+    pub fn show(&self, v: &Value) -> String {
+        let text = self.reading(v).unwrap_or_else(|| alloc::format!("{v}"));
+        match (self.shown_unit(), v) {
+            ("", _)
+            | (_, Value::Enum { .. } | Value::Flag(_) | Value::Bytes(_) | Value::Absent) => text,
+            (unit, _) => alloc::format!("{text} {unit}"),
+        }
     }
 
     /// Writes a number into the field, leaving the other bits of its bytes
@@ -545,6 +637,42 @@ mod tests {
         assert!(f.check(0xFF).is_ok());
         assert!(f.check(0x01).is_err());
         assert_eq!(f.allowed(), "0 = LP_TU, 255 = LP_OK");
+    }
+
+    #[test]
+    fn scaled_numbers_read_in_their_unit() {
+        const HUNDREDTHS: Scale = Scale {
+            unit: "dBµV",
+            factor: 0.01,
+            decimals: 2,
+        };
+        let f = Field::uint("s0", "S0", 0, 3)
+            .order(Order::LsbFirst)
+            .unit("0.01 dBµV")
+            .scaled(HUNDREDTHS);
+        // ST7570 UM 9 step 2: S0 F6.19.00h = 6646 = 66.46 dBµV.
+        let v = f.read(&[0xF6, 0x19, 0x00]).unwrap();
+        assert_eq!(f.reading(&v).as_deref(), Some("66.46"));
+        assert_eq!(f.show(&v), "66.46 dBµV");
+        assert_eq!(f.shown_unit(), "dBµV");
+        assert_eq!(HUNDREDTHS.text(0), "0.00");
+        assert_eq!(HUNDREDTHS.text(5), "0.05");
+        assert_eq!(HUNDREDTHS.text(-1250), "-12.50");
+        assert_eq!(HUNDREDTHS.text(0xFF_FFFF), "167772.15");
+        let thirds = Scale {
+            unit: "x",
+            factor: 1.0 / 3.0,
+            decimals: 0,
+        };
+        assert_eq!(thirds.text(2), "1");
+        assert_eq!(thirds.text(-2), "-1");
+        assert_eq!(thirds.text(-1), "0");
+        // Not scaled: as it is, with the raw unit.
+        let hz = Field::uint("hz", "Hz", 0, 2).unit("Hz");
+        let v = hz.read(&[0x01, 0x00]).unwrap();
+        assert_eq!((hz.reading(&v), hz.show(&v)), (None, "256 Hz".into()));
+        let e = Field::enumeration("e", "E", 0, 0, 2, NAMES).unit("Hz");
+        assert_eq!(e.show(&e.read(&[1]).unwrap()), "one");
     }
 
     #[test]

@@ -9,7 +9,8 @@
 //! generic code; `tests/json_props.rs` holds this module to serde_json's
 //! output byte for byte.
 //!
-//! Numbers: everything plm-core writes is a whole number ([`Json::Int`]).
+//! Numbers: plm-core writes whole numbers ([`Json::Int`]), and the
+//! decimal text of a field read in its unit ([`crate::field::Scale::text`]).
 //! Any other number read from a file is kept as its text
 //! ([`Json::Number`]) and written back as read, so no float formatting is
 //! needed.

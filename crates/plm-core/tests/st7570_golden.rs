@@ -25,11 +25,20 @@ fn to_json(v: &Value) -> Json {
     }
 }
 
+/// The fields by name; a number read in the manual's unit (S0 in dBµV,
+/// SNR0 in dB: the field's scale) in that unit, its raw number beside it.
 fn named(pairs: Vec<(&'static plm_core::field::Field, Value)>) -> Map<String, Json> {
-    pairs
-        .into_iter()
-        .map(|(f, v)| (f.name.to_string(), to_json(&v)))
-        .collect()
+    let mut m = Map::new();
+    for (f, v) in pairs {
+        if let Some(text) = f.reading(&v) {
+            let reading = serde_json::from_str(&text).expect("a reading is a JSON number");
+            m.insert(f.name.to_string(), reading);
+            m.insert(format!("{}_raw", f.name), to_json(&v));
+        } else {
+            m.insert(f.name.to_string(), to_json(&v));
+        }
+    }
+    m
 }
 
 fn subset(want: &Json, got: &Map<String, Json>, what: &str, errors: &mut Vec<String>) {

@@ -35,16 +35,11 @@ pub(crate) fn fields_html(layout: &'static [Field], data: &[u8]) -> String {
     plm_core::mib::describe(layout, data)
         .into_iter()
         .fold(String::new(), |mut html, (f, v)| {
-            let unit = if f.unit.is_empty() || v.as_i64().is_none() {
-                String::new()
-            } else {
-                format!(" {}", f.unit)
-            };
             html.push_str(&format!(
                 "<tr data-field=\"{}\"><th>{}</th><td>{}</td></tr>",
                 f.name,
                 escape(f.label),
-                escape(&format!("{v}{unit}"))
+                escape(&f.show(&v))
             ));
             html
         })

@@ -434,6 +434,13 @@ fn card_html(
         let visible = field.settable || field.get(current).is_some_and(|v| v != 0);
         let differs = read.is_some_and(|v| field.read(v) != field.read(object.default));
         let invalid = problems.get(name);
+        // An input takes the raw number; a value shown reads in its unit
+        // (S0 in dBµV).
+        let unit = if editable {
+            field.unit
+        } else {
+            field.shown_unit()
+        };
         let _ = write!(
             h,
             "<tr data-field=\"{name}\" class=\"{}{}\"{}><th>{}{}</th><td>",
@@ -441,10 +448,9 @@ fn card_html(
             if invalid.is_some() { "invalid" } else { "" },
             if visible { "" } else { " hidden" },
             escape(field.label),
-            if field.unit.is_empty() {
-                String::new()
-            } else {
-                escape(&format!(" ({})", field.unit))
+            match unit {
+                "" => String::new(),
+                unit => escape(&format!(" ({unit})")),
             },
         );
         let value = escape(&inputs.get(name).cloned().unwrap_or_default());

@@ -8,7 +8,7 @@
 //! written or read (Access layer mode, Operating mode) and 0000h (FIMA,
 //! LIMA), or from [`super::Decoder::fix_layer`], which wins.
 
-use super::{json_value, put_hex, Decoded};
+use super::{put_hex, put_value, Decoded};
 use crate::field::{Field, Value};
 use crate::json::{Json, Object};
 use crate::link::{LocalFrame, Source};
@@ -100,7 +100,7 @@ impl Context {
     pub(super) fn status(&mut self, data: &[u8], d: &mut Decoded) {
         let mut fields = Object::new();
         for (field, v) in status::describe(data) {
-            fields.insert(field.name, json_value(&v));
+            put_value(&mut fields, field, &v);
         }
         if let Some(s) = st7570::Status::parse(data) {
             // Bits set where the row has a fixed 0: shown, never dropped.
@@ -199,7 +199,7 @@ pub(super) fn put_fields(map: &mut Object, layout: &'static [Field], data: &[u8]
             (Value::Uint(a), 0xFFF) => u16::try_from(*a).ok().and_then(Group::of),
             _ => None,
         };
-        map.insert(field.name, json_value(&v));
+        put_value(map, field, &v);
         if let Some(g) = group {
             map.insert(
                 format!("{}_group", field.name),

@@ -5,23 +5,42 @@
 //! (5.2.1) except the MAC ADDRESS (Table 38: MSByte first) and the spy
 //! ALARM pattern (Table 57: MSByte first).
 
-use crate::field::{sparse_names, Field, Order};
+use crate::field::{sparse_names, Field, Order, Scale};
 
-/// S0/N0/S1/N1 raw estimations: dBµV RMS = value / 100 (3.6.1, Equation 1).
+/// S0/N0/S1/N1 raw estimations (and every number the manual gives as
+/// 100·dBµV): one step is 0.01 dBµV.
 pub const SN_UNIT: &str = "0.01 dBµV";
-/// SNR0/SNR1 fine estimations: SNR[dB] = 10·64·value·log10(2)·2^-19
-/// (3.6.1, Equation 2), so one unit is 640·log10(2)/2^19 dB.
+/// SNR0/SNR1 fine estimations: one step is 640·log10(2)/2^19 dB.
 pub const SNR_UNIT: &str = "640·log10(2)/2^19 dB";
+
+/// 3.6.1, Equation 1: V_RMS [dBµV] = value / 100, given to the hundredth
+/// as Table 3 and section 9 give it.
+pub const DBUV: Scale = Scale {
+    unit: "dBµV",
+    factor: 0.01,
+    decimals: 2,
+};
+/// 3.6.1, Equation 2: SNR [dB] = 10·64·value·log10(2)·2^-19, given to
+/// three places as section 9 gives it (24.936 dB; one step is 0.00037 dB).
+pub const SNR_DB: Scale = Scale {
+    unit: "dB",
+    factor: 640.0 * core::f64::consts::LOG10_2 / (1u32 << 19) as f64,
+    decimals: 3,
+};
+
+/// A number in 0.01 dBµV (S0..N1, S, N, AL_*, thresholds), read in dBµV.
+pub const fn in_dbuv(f: Field) -> Field {
+    f.unit(SN_UNIT).scaled(DBUV)
+}
 
 /// dBµV RMS of a raw signal or noise estimation (3.6.1, Equation 1).
 pub fn sn_dbuv(value: u32) -> f64 {
-    value as f64 / 100.0
+    DBUV.of(value as i64)
 }
 
 /// dB of a raw SNR estimation (3.6.1, Equation 2).
 pub fn snr_db(value: u32) -> f64 {
-    const LOG10_2: f64 = core::f64::consts::LOG10_2;
-    10.0 * 64.0 * value as f64 * LOG10_2 / (1u32 << 19) as f64
+    SNR_DB.of(value as i64)
 }
 
 /// Electrical delta-phase codes of Table 4 (1200 bps column; at 2400 bps
@@ -130,7 +149,7 @@ const fn le(f: Field) -> Field {
 
 /// A 3-byte raw signal or noise estimation, LSByte first.
 const fn sn(name: &'static str, label: &'static str, offset: usize) -> Field {
-    le(Field::uint(name, label, offset, 3)).unit(SN_UNIT)
+    in_dbuv(le(Field::uint(name, label, offset, 3)))
 }
 
 /// S0, N0, S1, N1 at bytes 0..11 (Tables 17, 50, 52, 55; shifted where
@@ -167,7 +186,9 @@ const fn fsk(offset: usize) -> Field {
     le(Field::uint("fsk", "FSK", offset, 2))
 }
 const fn snr(name: &'static str, label: &'static str, offset: usize) -> Field {
-    le(Field::uint(name, label, offset, 3)).unit(SNR_UNIT)
+    le(Field::uint(name, label, offset, 3))
+        .unit(SNR_UNIT)
+        .scaled(SNR_DB)
 }
 const fn mac_address(name: &'static str, label: &'static str, offset: usize) -> Field {
     le(Field::uint(name, label, offset, 2)).range(0, 0xFFF)
@@ -219,7 +240,7 @@ pub mod mac_sync {
         SYNC,
         Field::enumeration("cause", "CAUSE", 1, 0, 8, INTELLIGENT_CAUSES),
         mac_address("add", "ADD", 2),
-        le(Field::uint("s", "S", 4, 2)).unit(SN_UNIT),
+        in_dbuv(le(Field::uint("s", "S", 4, 2))),
     ];
     /// Data bytes of FOUND.
     pub const FOUND_LEN: usize = 15;
@@ -407,7 +428,7 @@ pub mod spy_alarm {
 /// 61h (Table 61).
 pub const RC_REQUEST: &[Field] = &[
     le(Field::uint("tx_pos", "TX_POS", 0, 2)),
-    le(Field::uint("rc_threshold", "RC_THRESHOLD", 2, 2)).unit(SN_UNIT),
+    in_dbuv(le(Field::uint("rc_threshold", "RC_THRESHOLD", 2, 2))),
 ];
 
 /// 62h (Table 63): RESULT, REPEATER STATE, and for a Server with LP_OK
@@ -446,7 +467,7 @@ pub mod is_indication {
     pub const LONG: &[Field] = &[
         IS_STATUS,
         mac_address("add", "ADD", 1),
-        le(Field::uint("s", "S", 3, 2)).unit(SN_UNIT),
+        in_dbuv(le(Field::uint("s", "S", 3, 2))),
     ];
     /// Bytes of the long form.
     pub const LONG_LEN: usize = 5;

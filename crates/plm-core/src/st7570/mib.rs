@@ -5,7 +5,7 @@
 //! first"). Where Table 71 and an object's own table disagree, the
 //! object's table wins (docs/protocol-notes.md).
 
-use super::fields::{REPEATER_STATES, SN_UNIT};
+use super::fields::{in_dbuv, REPEATER_STATES};
 use super::Layer;
 use crate::field::{Field, Order};
 use crate::link::TicSelector;
@@ -158,13 +158,11 @@ pub const TIC_REPEATER: &[Field] = &[
     ),
 ];
 pub(super) const RC_THRESHOLD: &[Field] = &[
-    u16le("rc_threshold", "RC threshold", 0).unit(SN_UNIT),
+    in_dbuv(u16le("rc_threshold", "RC threshold", 0)),
     u16le("pad", "PAD", 2).range(0, 0),
 ];
 const fn estimation(name: &'static str, label: &'static str, offset: usize) -> Field {
-    le(Field::uint(name, label, offset, 4))
-        .range(0, 0x0FF_FFFF)
-        .unit(SN_UNIT)
+    in_dbuv(le(Field::uint(name, label, offset, 4)).range(0, 0x0FF_FFFF))
 }
 pub(super) const S0_N0_PGA: &[Field] = &[
     estimation("s0", "S0", 0),
@@ -199,9 +197,9 @@ pub(super) const AUTO_SYNCHRO_REJECT: &[Field] = &[Field::enumeration(
     8,
     &["disabled", "enabled"],
 )];
-pub(super) const IS_THRESHOLD: &[Field] = &[le(Field::uint("is_threshold", "IS threshold", 0, 4))
-    .range(0, 0x0FFF_FFFF)
-    .unit(SN_UNIT)];
+pub(super) const IS_THRESHOLD: &[Field] = &[in_dbuv(
+    le(Field::uint("is_threshold", "IS threshold", 0, 4)).range(0, 0x0FFF_FFFF),
+)];
 pub(super) const ON_OFF: &[&str] = &["disabled", "enabled"];
 pub(super) const CURRENT_LIMITING: Field =
     Field::enumeration("current_limiting", "Current limiting", 0, 0, 8, ON_OFF);
