@@ -15,7 +15,9 @@
 //!   start; one that does not resets [`FAIL_AFTER`] after it, and the
 //!   bootloader goes back to the old image. A simulated image "comes up"
 //!   when its descriptor names the release its header announced
-//!   ([`firmware_image`] builds such images).
+//!   ([`firmware_image`] builds such images), or, with no descriptor
+//!   ([`plain_image`]), when its vector table is an application's; it
+//!   reports the release its header announced (0.0 when none was stated).
 
 use crate::flash::{Boot, Flash, Record};
 use crate::rng::Rng;
@@ -36,21 +38,33 @@ pub const FAIL_AFTER: Duration = 2_000 * MS;
 /// Bytes of the simulated boards' factory image.
 pub const FACTORY_SIZE: usize = 24 * 1024;
 
-/// A simulated firmware image of `size` bytes (at least a vector table and
-/// the descriptor) for release `version`: a stack pointer, vectors into
-/// slot 0, bytes that stand for code, sealed with its descriptor
-/// (`plm_core::app::rfu::image`), so that it passes the check the console
-/// and `plm board rfu` make.
-pub fn firmware_image(version: Release, size: usize) -> Vec<u8> {
-    let size = size.clamp(image::IMAGE_MIN, rfu::IMAGE_MAX);
+/// A simulated raw image of `size` bytes as ST's toolchain writes one
+/// (UM 4.3: the application's `.bin`, no descriptor): an initial stack
+/// pointer, every vector into slot 0 (the reserved ones 0), then bytes that
+/// stand for code (`seed` varies them). It names no release.
+pub fn plain_image(seed: u8, size: usize) -> Vec<u8> {
+    let size = size.clamp(VECTORS + 4, rfu::IMAGE_MAX);
     let mut bytes: Vec<u8> = (0..size)
-        .map(|i| (i as u32).wrapping_mul(2_654_435_761).to_be_bytes()[0] ^ version.minor)
+        .map(|i| (i as u32).wrapping_mul(2_654_435_761).to_be_bytes()[0] ^ seed)
         .collect();
     bytes[..4].copy_from_slice(&0x2000_5000u32.to_le_bytes());
     for (n, at) in (4..VECTORS).step_by(4).enumerate() {
-        let v = image::LINK_BASE + 0x200 + 4 * n as u32 + 1;
+        let v = if image::RESERVED.contains(&at) {
+            0
+        } else {
+            image::LINK_BASE + VECTORS as u32 + 4 * n as u32 + 1
+        };
         bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
     }
+    bytes
+}
+
+/// A simulated firmware image of `size` bytes (at least a vector table and
+/// the descriptor) for release `version`: a [`plain_image`] sealed with its
+/// descriptor (`plm_core::app::rfu::image`), so that the console and
+/// `plm board rfu` check its release, size and CRC too.
+pub fn firmware_image(version: Release, size: usize) -> Vec<u8> {
+    let mut bytes = plain_image(version.minor, size.max(image::IMAGE_MIN));
     image::seal(&mut bytes, version);
     bytes
 }
@@ -68,11 +82,15 @@ fn factory_image(version: Release) -> Arc<[u8]> {
 }
 
 /// Whether the image `record` names comes up: its descriptor names the
-/// release its header announced (an image of another release, or none,
-/// stands for firmware that crashes at start).
+/// release its header announced (an image of another release stands for
+/// firmware that crashes at start); an image without one, when it passes
+/// the check tools make (a vector table of an application for the slot).
 fn comes_up(flash: &Flash, record: &Record) -> bool {
-    let head = flash.image(record.slot as usize, image::IMAGE_MIN);
-    image::release_of(&head) == Some(record.version)
+    let bytes = flash.image(record.slot as usize, record.size as usize);
+    match image::release_of(&bytes) {
+        Some(release) => release == record.version,
+        None => image::check(&bytes).is_ok(),
+    }
 }
 
 /// A campaign under way.

@@ -207,6 +207,12 @@ pub struct RfuArgs {
     /// Start a new campaign even if a saved one exists (it is replaced).
     #[arg(long)]
     pub restart: bool,
+    /// The release the image reports once it runs, X.Y. A plain .bin (as
+    /// ST's toolchain writes it) names none: without this, the update is
+    /// judged by the swap, the restart and the board answering. An image
+    /// with a descriptor must name the same.
+    #[arg(long, value_name = "X.Y", value_parser = parse_release)]
+    pub release: Option<Release>,
     /// Milliseconds between two segments broadcast (the line's time for
     /// one; shorter only on a quiet line, or on `plm sim`).
     #[arg(long, default_value_t = 250, value_parser = clap::value_parser!(u64).range(20..=10_000))]
@@ -216,9 +222,11 @@ pub struct RfuArgs {
 /// `plm board image`.
 #[derive(Args)]
 pub struct ImageArgs {
-    /// The release the image reports once it runs, X.Y.
+    /// The release the image reports once it runs, X.Y, written in a
+    /// descriptor; without it, a plain image as ST's toolchain writes one
+    /// (a vector table and code, no release).
     #[arg(long = "version", value_name = "X.Y", value_parser = parse_release)]
-    pub release: Release,
+    pub release: Option<Release>,
     /// Image size in bytes.
     #[arg(long, default_value_t = 24_576, value_parser = clap::value_parser!(u32).range(
         plm_core::app::rfu::image::IMAGE_MIN as i64..=plm_core::app::rfu::IMAGE_MAX as i64))]

@@ -6,7 +6,7 @@
 use super::driver::{interrupted, Driver};
 use super::{connect, exit, session, BoardArgs, Failure, ImageArgs, RfuArgs};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use plm_core::app::rfu::image;
+use plm_core::app::rfu::{self, image};
 use plm_core::app::update::{BoardState, Update, UpdateConfig};
 use plm_core::app::{Address, AppEvent, Happening, RequestId};
 use plm_core::time::MS;
@@ -41,15 +41,19 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// `plm board image`.
 pub fn write_image(args: &ImageArgs) -> Result<u8, Failure> {
-    let bytes = plm_sim::rfu::firmware_image(args.release, args.size as usize);
+    let size = args.size as usize;
+    let bytes = match args.release {
+        Some(release) => plm_sim::rfu::firmware_image(release, size),
+        None => plm_sim::rfu::plain_image(0, size),
+    };
     let info = image::check(&bytes)
         .map_err(|why| Failure::input(format!("the image made is not good: {why} (a bug)")))?;
     std::fs::write(&args.output, &bytes)
         .map_err(|e| Failure::input(format!("cannot write {}: {e}", args.output.display())))?;
     say!(
-        "{}: simulated firmware image, release {}, {} bytes, CRC-32 {:08X} (campaign {})",
+        "{}: simulated firmware image, {}, {} bytes, CRC-32 {:08X} (campaign {})",
         args.output.display(),
-        info.version,
+        info.release_words(),
         info.size,
         info.crc,
         info.campaign()
@@ -78,11 +82,20 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
     let name = r.image.display().to_string();
     let bytes = std::fs::read(&r.image)
         .map_err(|e| Failure::input(format!("cannot read the image {name}: {e}")))?;
-    let info = image::check(&bytes).map_err(|why| {
-        Failure::input(format!(
-            "{name} is not an image the boards take: {why}. Nothing was sent."
-        ))
-    })?;
+    let info = image::check(&bytes)
+        .and_then(|i| i.stating(r.release))
+        .map_err(|why| {
+            Failure::input(format!(
+                "{name} is not an image the boards take: {why}. Nothing was sent."
+            ))
+        })?;
+    if info.release.is_none() {
+        tell!(
+            "plm board: {name} states no release (a plain .bin names none; give one with \
+             --release X.Y): each board is judged by its swap, its restart and its answer, \
+             and the release it reports is shown"
+        );
+    }
     let state = State {
         path: state_path(r),
     };
@@ -153,16 +166,16 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
                 gap: r.gap_ms * MS,
                 ..UpdateConfig::default()
             };
-            Update::new(info.campaign(), info.version, bytes, &targets, config)
+            Update::new(info.campaign(), info.release, bytes, &targets, config)
                 .map_err(|why| Failure::input(format!("cannot update: {why}")))?
         }
     };
     let h = u.header();
     tell!(
-        "plm board: campaign {}: {name}, release {}, {} bytes ({} segments), CRC-32 {:08X}, \
+        "plm board: campaign {}: {name}, {}, {} bytes ({} segments), CRC-32 {:08X}, \
          to {} board{}; progress saved in {shown}",
         h.campaign,
-        h.version,
+        rfu::release_words(h.release()),
         h.size,
         h.segments(),
         h.crc,
@@ -223,10 +236,10 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
         tell!("plm board: the update is over but its state file {shown} could not be removed: {e}");
     }
     tell!(
-        "plm board: {updated} of {} board{} updated to {}",
+        "plm board: {updated} of {} board{} updated ({})",
         report.len(),
         if report.len() == 1 { "" } else { "s" },
-        h.version
+        rfu::release_words(h.release())
     );
     Ok(if updated == report.len() {
         exit::OK

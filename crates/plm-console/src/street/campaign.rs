@@ -6,7 +6,7 @@ use super::{Purpose, StreetSession};
 use crate::transport::LinkState;
 use plm_core::app::rfu::image;
 use plm_core::app::update::{Update, UpdateConfig};
-use plm_core::app::{Address, Message};
+use plm_core::app::{Address, Message, Release};
 use plm_core::time::Instant;
 
 /// A campaign under way (or over, its results kept until dismissed).
@@ -31,13 +31,19 @@ impl StreetSession {
         self.campaign.as_ref()
     }
 
-    /// Starts updating `targets` with `image`, refused in words (before
+    /// Starts updating `targets` with `image` (reporting release `stated`
+    /// once it runs, when the file names none), refused in words (before
     /// anything is sent) when the image cannot be a whole firmware image.
-    pub fn start_update(&mut self, image: Vec<u8>, targets: &[Address]) -> Result<(), String> {
-        let info = image::check(&image)?;
+    pub fn start_update(
+        &mut self,
+        image: Vec<u8>,
+        stated: Option<Release>,
+        targets: &[Address],
+    ) -> Result<(), String> {
+        let info = image::check(&image)?.stating(stated)?;
         let u = Update::new(
             info.campaign(),
-            info.version,
+            info.release,
             image,
             targets,
             UpdateConfig::default(),
@@ -149,18 +155,19 @@ impl StreetSession {
         let Some(c) = self.campaign.as_ref() else {
             return;
         };
-        let version = c.update.header().version;
-        let done: Vec<Address> = c
+        let stated = c.update.header().release();
+        let done: Vec<(Address, Option<Release>)> = c
             .update
             .boards()
-            .filter(|(_, s)| **s == plm_core::app::update::BoardState::Done)
-            .map(|(a, _)| a)
+            .enumerate()
+            .filter(|(_, (_, s))| **s == plm_core::app::update::BoardState::Done)
+            .map(|(i, (a, _))| (a, stated.or(c.update.firmware(i))))
             .collect();
         let sweep = c.sweep_was_on;
         let now = self.now();
-        for a in done {
-            if let Some(d) = self.lamp(a).discovered.as_mut() {
-                d.firmware = version;
+        for (a, release) in done {
+            if let (Some(d), Some(r)) = (self.lamp(a).discovered.as_mut(), release) {
+                d.firmware = r;
             }
         }
         self.out.campaign = true;
@@ -183,7 +190,7 @@ mod tests {
     use plm_core::app::{Concentrator, Release, RequesterConfig};
     use plm_core::time::{Duration, MS};
     use plm_sim::board::street_address;
-    use plm_sim::rfu::firmware_image;
+    use plm_sim::rfu::{firmware_image, plain_image};
     use plm_sim::Attach;
 
     const S: Duration = 1_000 * MS;
@@ -220,13 +227,13 @@ mod tests {
         let mut truncated = firmware_image(NEW, 3_000);
         truncated.truncate(2_000);
         assert!(s
-            .start_update(truncated, &[street_address(1)])
+            .start_update(truncated, None, &[street_address(1)])
             .unwrap_err()
             .starts_with("truncated"));
         assert!(s.campaign().is_none(), "nothing started");
 
         let targets = [street_address(1), street_address(2)];
-        s.start_update(firmware_image(NEW, 3_000), &targets)
+        s.start_update(firmware_image(NEW, 3_000), None, &targets)
             .unwrap();
         assert!(!s.sweep().on, "the sweep leaves the line to the update");
         run(&mut s, 120 * S);
@@ -241,6 +248,50 @@ mod tests {
         assert!(s.campaign().is_none());
     }
 
+    /// A plain `.bin` (as ST's toolchain writes it) updates a lamp: with
+    /// no release stated the lamp shows what it reports after its
+    /// restart; with one, that release; a descriptor's release other than
+    /// the one stated is refused before anything is sent.
+    #[test]
+    fn a_plain_image_updates_a_lamp() {
+        let mut s = street(2);
+        s.discover();
+        run(&mut s, 30 * S);
+        let plain = plain_image(3, 3_000);
+        s.start_update(plain.clone(), None, &[street_address(1)])
+            .unwrap();
+        run(&mut s, 60 * S);
+        let c = s.campaign().unwrap();
+        let report = c.update.report();
+        assert!(
+            report[0]
+                .1
+                .starts_with("updated: it restarted and answers, reporting release 0.0"),
+            "{report:?}"
+        );
+        assert_eq!(release_of(&s, 1), plm_core::app::rfu::RELEASE_NOT_STATED);
+        s.dismiss_update();
+
+        let stated = Release { major: 2, minor: 1 };
+        s.start_update(plain_image(4, 3_000), Some(stated), &[street_address(2)])
+            .unwrap();
+        run(&mut s, 60 * S);
+        let c = s.campaign().unwrap();
+        assert_eq!(c.update.report()[0].1, "updated to 2.1");
+        assert_eq!(release_of(&s, 2), stated);
+        s.dismiss_update();
+
+        let why = s
+            .start_update(
+                firmware_image(NEW, 3_000),
+                Some(stated),
+                &[street_address(2)],
+            )
+            .unwrap_err();
+        assert!(why.contains("says it is release 1.9, not 2.1"), "{why}");
+        assert!(s.campaign().is_none(), "nothing started");
+    }
+
     /// A campaign saved mid-way goes on in a new session (a reload with
     /// the same street behind the cable) and finishes.
     #[test]
@@ -249,7 +300,7 @@ mod tests {
         s.discover();
         run(&mut s, 30 * S);
         let image = firmware_image(NEW, 4_000);
-        s.start_update(image.clone(), &[street_address(1), street_address(2)])
+        s.start_update(image.clone(), None, &[street_address(1), street_address(2)])
             .unwrap();
         run(&mut s, 6 * S);
         let saved = s.campaign().unwrap().update.save();

@@ -32,9 +32,18 @@ impl Chosen {
 
     fn words(&self) -> String {
         match &self.check {
+            Ok(i) if i.described => format!(
+                "{}: {} bytes, {}, CRC-32 {:08X} (descriptor checked)",
+                self.name,
+                i.size,
+                i.release_words(),
+                i.crc
+            ),
             Ok(i) => format!(
-                "{}: {} bytes, release {}, CRC-32 {:08X}",
-                self.name, i.size, i.version, i.crc
+                "{}: {} bytes, CRC-32 {:08X}, vector table checked; a plain .bin names no \
+                 release: state the one it reports, or each lamp is judged by its swap, \
+                 restart and answer",
+                self.name, i.size, i.crc
             ),
             Err(why) => format!("{} refused: {why}", self.name),
         }
@@ -76,6 +85,7 @@ pub fn UpdateView() -> impl IntoView {
     let choice = signal(String::from("all"));
     let message = signal(None::<String>);
     let make_release = signal(String::from("1.5"));
+    let stated = signal(String::new());
     let make_size = signal(String::from("24576"));
     let running = move || {
         street.campaign.track();
@@ -94,9 +104,13 @@ pub fn UpdateView() -> impl IntoView {
         });
     };
     let make = move || {
-        let Some(v) = release(&make_release.get_untracked()) else {
-            return message.set(Some("the release is x.y, two numbers 0-255".into()));
-        };
+        let text = make_release.get_untracked();
+        let v = release(&text);
+        if v.is_none() && !text.trim().is_empty() {
+            return message.set(Some(
+                "the release is x.y, two numbers 0-255 (or empty for a plain .bin)".into(),
+            ));
+        }
         let size = make_size
             .get_untracked()
             .trim()
@@ -109,16 +123,33 @@ pub fn UpdateView() -> impl IntoView {
                 plm_core::app::rfu::IMAGE_MAX
             )));
         }
-        let bytes = plm_sim::rfu::firmware_image(v, size);
-        chosen.set(Some(Chosen::of(format!("simulated-{v}.bin"), bytes)));
+        let (name, bytes) = match v {
+            Some(v) => (
+                format!("simulated-{v}.bin"),
+                plm_sim::rfu::firmware_image(v, size),
+            ),
+            None => (
+                "simulated-plain.bin".into(),
+                plm_sim::rfu::plain_image(0, size),
+            ),
+        };
+        chosen.set(Some(Chosen::of(name, bytes)));
         message.set(None);
     };
     let start = move || {
         let Some(c) = chosen.get_untracked() else {
             return message.set(Some("choose an image file first".into()));
         };
+        let text = stated.get_untracked();
+        let said = release(&text);
+        if said.is_none() && !text.trim().is_empty() {
+            return message.set(Some(format!(
+                "nothing sent: '{}' is not a release: x.y, two numbers 0-255 (or empty)",
+                text.trim()
+            )));
+        }
         let list = targets(street, &choice.get_untracked());
-        let r = street.act(|s| s.start_update(c.bytes, &list));
+        let r = street.act(|s| s.start_update(c.bytes, said, &list));
         message.set(Some(match r {
             Ok(()) => format!("update started on {} lamp(s)", list.len()),
             Err(e) => format!("nothing sent: {e}"),
@@ -163,7 +194,7 @@ pub fn UpdateView() -> impl IntoView {
                     "Image file "
                     <input type="file" id="update-file" accept=".bin,.img,application/octet-stream" on:change=on_event(on_file)/>
                 </label>
-                <span class="muted">"or make a simulated one: release "</span>
+                <span class="muted">"or make a simulated one: release (empty: a plain .bin) "</span>
                 {text_input("update-make-release", "", "x.y", Some(5), make_release)}
                 <span class="muted">" bytes "</span>
                 {text_input("update-make-size", "", "", Some(6), make_size)}
@@ -182,6 +213,10 @@ pub fn UpdateView() -> impl IntoView {
                 {move || chosen.with(|c| c.as_ref().map_or("no image chosen".into(), Chosen::words))}
             </p>
             <div class="toolbar">
+                <label title="a plain .bin names no release; a file with a descriptor must name the same">
+                    "Release it reports (optional) "
+                    {text_input("update-release", "", "x.y", Some(5), stated)}
+                </label>
                 <label>
                     "Lamps "
                     {select(
@@ -293,8 +328,8 @@ fn snapshot(street: StreetStore) -> Option<Snapshot> {
             .count();
         let overall = lines.iter().map(|l| l.2 as usize).sum::<usize>() / lines.len().max(1);
         let head = format!(
-            "release {} to {} lamp(s): {done} updated, {failed} not updated",
-            u.header().version,
+            "{} to {} lamp(s): {done} updated, {failed} not updated",
+            plm_core::app::rfu::release_words(u.header().release()),
             lines.len()
         );
         let summary = match c.ended {

@@ -23,6 +23,8 @@ pub mod image;
 
 use super::service::Release;
 use crate::CrcImpl;
+use alloc::format;
+use alloc::string::String;
 use crc::{Crc, CRC_32_ISO_HDLC};
 
 /// Largest image: an image slot (4.2: "the maximum size of the firmware
@@ -59,6 +61,19 @@ pub fn segments(size: usize) -> usize {
     size.div_ceil(SEGMENT)
 }
 
+/// The release a header announces for an image that states none (a plain
+/// `.bin` and no release given): 0.0 (decided here; docs/
+/// protocol-notes.md, "The image file").
+pub const RELEASE_NOT_STATED: Release = Release { major: 0, minor: 0 };
+
+/// A campaign's release in words: "release 1.5", or that it states none.
+pub fn release_words(release: Option<Release>) -> String {
+    match release {
+        Some(r) => format!("release {r}"),
+        None => "release not stated (a plain .bin names none)".into(),
+    }
+}
+
 /// SERVICE_RFU_SET_IMG_HEADER: a new image is coming.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Header {
@@ -85,6 +100,12 @@ impl Header {
             crc: image_crc(image),
             segment: SEGMENT as u8,
         }
+    }
+
+    /// The release announced, or `None` when the image states none
+    /// ([`RELEASE_NOT_STATED`]).
+    pub fn release(&self) -> Option<Release> {
+        (self.version != RELEASE_NOT_STATED).then_some(self.version)
     }
 
     /// Segments of the image.

@@ -146,6 +146,8 @@ struct Target {
     not_before: Instant,
     /// Done before a resume: its release is being read back.
     rechecked: bool,
+    /// The release it reported after its restart.
+    firmware: Option<Release>,
 }
 
 /// Where the campaign is.
@@ -184,10 +186,11 @@ pub struct Update {
 }
 
 impl Update {
-    /// A campaign that puts `image`, release `version`, on `targets`.
+    /// A campaign that puts `image`, release `version` (`None`: the image
+    /// states none), on `targets`.
     pub fn new(
         campaign: u8,
-        version: Release,
+        version: impl Into<Option<Release>>,
         image: Vec<u8>,
         targets: &[Address],
         config: UpdateConfig,
@@ -206,7 +209,11 @@ impl Update {
             return Err("no board to update".into());
         }
         Ok(Update {
-            header: Header::of(campaign, version, &image),
+            header: Header::of(
+                campaign,
+                version.into().unwrap_or(rfu::RELEASE_NOT_STATED),
+                &image,
+            ),
             image,
             config,
             targets: targets
@@ -218,12 +225,19 @@ impl Update {
                     restarts: 0,
                     not_before: 0,
                     rechecked: false,
+                    firmware: None,
                 })
                 .collect(),
             phase: Phase::Announce,
             waiting: Waiting::Nothing,
             sent: 0,
         })
+    }
+
+    /// The release board `i` (in [`Update::boards`]'s order) reported
+    /// after its restart, once it did.
+    pub fn firmware(&self, i: usize) -> Option<Release> {
+        self.targets.get(i)?.firmware
     }
 
     /// The header every board gets.
@@ -552,7 +566,10 @@ impl Update {
                 "refused the swap: the image it holds does not check".into(),
             ),
             (BoardState::Restarting(_), Ok(Message::Service(Service::FwRel { firmware, .. }))) => {
-                if firmware == self.header.version {
+                self.targets[b].firmware = Some(firmware);
+                // An image that states no release is judged by its swap's
+                // ACK, the restart and the board answering.
+                if self.header.release().is_none_or(|v| firmware == v) {
                     BoardState::Done
                 } else if self.targets[b].rechecked {
                     // Done before a resume, not any more: announced again.
@@ -622,7 +639,12 @@ impl Update {
             .iter()
             .map(|t| {
                 let words = match &t.state {
-                    BoardState::Done => format!("updated to {}", self.header.version),
+                    BoardState::Done => match (self.header.release(), t.firmware) {
+                        (None, Some(f)) => format!(
+                            "updated: it restarted and answers, reporting release {f} (the image states none)"
+                        ),
+                        _ => format!("updated to {}", self.header.version),
+                    },
                     BoardState::Aborted => "not updated: the update was aborted".into(),
                     BoardState::Failed(why) => format!("not updated: {why}"),
                     _ => "in progress".into(),

@@ -157,6 +157,7 @@ impl Update {
             targets.push(Target {
                 address,
                 rechecked: tag == 4,
+                firmware: None,
                 state,
                 silences,
                 restarts,
