@@ -356,6 +356,113 @@ fn rfu_updates_one_board_and_refuses_bad_input() {
     server.interrupt();
 }
 
+/// A plain `.bin` as ST's toolchain writes it (UM 4.3: a vector table
+/// and code, no descriptor, no release): `plm board image` without
+/// `--version` writes one; `rfu` refuses, in words and before connecting,
+/// one linked at 0800_0000h and one that is no STM32 application; then
+/// updates lamp 1 with the plain image and `--release 2.0` (lamp 1
+/// reports 2.0) and lamp 2 with none (judged by its restart and answer,
+/// the release it reports shown).
+#[test]
+fn rfu_takes_a_plain_bin() {
+    let mut server = street("2");
+    let dir = Scratch::new("plain");
+    let image = dir.text("PLM_HID_STANDALONE.bin");
+    let made = plm(
+        &dir,
+        "image",
+        &["board", "image", "--size", "3000", "-o", &image],
+    );
+    assert_eq!(made.code, Some(0), "{made:?}");
+    assert!(made.out.contains("release not stated"), "{}", made.out);
+    let bytes = std::fs::read(&image).unwrap();
+    assert_eq!(plm_core::app::rfu::image::release_of(&bytes), None);
+
+    // Built without the bootloader: every vector 4 KiB lower.
+    let mut at_base = bytes.clone();
+    for at in (4..plm_core::app::rfu::image::VECTORS).step_by(4) {
+        let v = u32::from_le_bytes(at_base[at..at + 4].try_into().unwrap());
+        if v != 0 {
+            at_base[at..at + 4].copy_from_slice(&(v - 0x1000).to_le_bytes());
+        }
+    }
+    let low = dir.text("low.bin");
+    std::fs::write(&low, &at_base).unwrap();
+    let refused = plm(&dir, "low", &board_args(&server, &["rfu", &low, &lamp(1)]));
+    assert_eq!(refused.code, Some(4), "{refused:?}");
+    assert!(
+        refused.err.contains("built without the bootloader"),
+        "{}",
+        refused.err
+    );
+    assert!(refused.err.contains("Nothing was sent"), "{}", refused.err);
+    // Not an application at all (text).
+    let text = dir.text("notes.bin");
+    std::fs::write(&text, "release notes for 2.0\n".repeat(40)).unwrap();
+    let refused = plm(
+        &dir,
+        "text",
+        &board_args(&server, &["rfu", &text, &lamp(1)]),
+    );
+    assert_eq!(refused.code, Some(4), "{refused:?}");
+    assert!(
+        refused.err.contains("not an STM32F103 application image"),
+        "{}",
+        refused.err
+    );
+    std::thread::sleep(Duration::from_millis(200));
+    let lines = server.lines_so_far();
+    assert!(
+        !lines.iter().any(|l| l.contains("connected")),
+        "the port was opened: {lines:?}"
+    );
+
+    let stated = board(
+        &mut server,
+        &dir,
+        "stated",
+        &[
+            "rfu",
+            &image,
+            &lamp(1),
+            "--release",
+            "2.0",
+            "--gap-ms",
+            "40",
+        ],
+    );
+    assert_eq!(stated.code, Some(0), "{stated:?}");
+    assert!(
+        stated.out.contains(&format!("{}  updated to 2.0", lamp(1))),
+        "{}",
+        stated.out
+    );
+    let s = board(&mut server, &dir, "status1", &["status", &lamp(1)]);
+    assert!(s.out.contains("firmware     2.0"), "{}", s.out);
+
+    let unstated = board(
+        &mut server,
+        &dir,
+        "unstated",
+        &["rfu", &image, &lamp(2), "--gap-ms", "40"],
+    );
+    assert_eq!(unstated.code, Some(0), "{unstated:?}");
+    assert!(
+        unstated.err.contains("states no release"),
+        "{}",
+        unstated.err
+    );
+    assert!(
+        unstated.out.contains(&format!(
+            "{}  updated: it restarted and answers, reporting release 0.0",
+            lamp(2)
+        )),
+        "{}",
+        unstated.out
+    );
+    server.interrupt();
+}
+
 /// An update of two lamps stopped by Ctrl-C (exit 130, state kept, how
 /// to resume said), resumed and killed outright, then resumed again:
 /// it finishes (exit 0) with both lamps on 1.5.
