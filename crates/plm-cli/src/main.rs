@@ -150,6 +150,12 @@ struct SimArgs {
     /// CMD_AlarmIndication come in (1-3600).
     #[arg(long, value_name = "SECONDS", value_parser = clap::value_parser!(u16).range(1..=3600))]
     alarms: Option<u16>,
+    /// With --chip st7570: the MAC Servers keep the factory bit rate, f0
+    /// and f1 (1200 bit/s, 74 kHz, 63.3 kHz) rather than taking on node
+    /// 0's as its host writes 00A1h (the default), so that a host that
+    /// sets others reaches no Server.
+    #[arg(long)]
+    factory_servers: bool,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -255,16 +261,31 @@ fn st7570_world(args: &SimArgs) -> Result<sim_server::World, String> {
             serve + 1
         ));
     }
+    if args.factory_servers && nodes == serve {
+        return Err(format!(
+            "--factory-servers: every node is served ({nodes}), there is no Server; \
+             add Servers with --nodes {} or more",
+            serve + 1
+        ));
+    }
     Ok(sim_server::World::St7570 {
         nodes,
         serve,
         alarms: args.alarms.map(|s| u64::from(s) * 1_000_000),
+        servers_follow: !args.factory_servers,
     })
 }
 
 fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
     if args.alarms.is_some() {
         return Err("--alarms needs --chip st7570: MAC Servers raise the alarms".into());
+    }
+    if args.factory_servers {
+        return Err(
+            "--factory-servers needs --chip st7570: the ST7580's echoing peers \
+             keep the factory MIB with --peers factory"
+                .into(),
+        );
     }
     let world = match (args.board, args.street) {
         (true, n) => sim_server::World::Street {

@@ -80,6 +80,10 @@ pub enum World {
         /// Every this many µs the next Server raises an alarm
         /// ([`alarms::Alarming`]); `None`: only when asked.
         alarms: Option<u64>,
+        /// The Servers take on node 0's bit rate, f0 and f1
+        /// ([`plm_sim::st7570::net::NetConfig::servers_follow`]); `false`:
+        /// they keep the factory ones (`--factory-servers`).
+        servers_follow: bool,
     },
     /// A street of lamps behind the served modem or concentrator board.
     Street {
@@ -145,6 +149,7 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         nodes,
         serve,
         alarms,
+        servers_follow,
     } = opts.world
     {
         return Ok(bind_st7570(
@@ -153,6 +158,7 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             nodes.max(serve),
             serve,
             alarms,
+            servers_follow,
             opts.seed,
         ));
     }
@@ -252,17 +258,22 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
 
 /// `plm sim --chip st7570`: an S-FSK line of `nodes` ST7570s, nodes
 /// 0..serve served at `addrs`, the others MAC Servers that configure
-/// themselves and answer what is sent to them.
+/// themselves (taking on node 0's bit rate, f0 and f1 if
+/// `servers_follow`) and answer what is sent to them.
 fn bind_st7570(
     addrs: Vec<SocketAddr>,
     listeners: Vec<TcpListener>,
     nodes: usize,
     serve: usize,
     alarms: Option<u64>,
+    servers_follow: bool,
     seed: u64,
 ) -> Bound {
     use plm_sim::st7570::net::{NetConfig, Network};
-    let config = NetConfig::served_line(nodes, serve, seed);
+    let config = NetConfig {
+        servers_follow,
+        ..NetConfig::served_line(nodes, serve, seed)
+    };
     let repeaters = config.repeaters();
     let net = Network::new(config);
     let addr = addrs[0];
@@ -305,6 +316,15 @@ fn bind_st7570(
              anything else echoed",
             nodes - 1
         ));
+        banner.push(if servers_follow {
+            "plm sim: the Servers take on node 0's bit rate, f0 and f1 (00A1h) as its host \
+             writes them"
+                .into()
+        } else {
+            "plm sim: the Servers keep the factory bit rate, f0 and f1 (1200 bit/s, 74 kHz, \
+             63.3 kHz; --factory-servers): a node 0 set otherwise reaches none"
+                .into()
+        });
         banner.push(if repeaters.is_empty() {
             "plm sim: no repeater (repeaters are nodes 3, 6, 9, ...: add --nodes 4 or more)".into()
         } else {

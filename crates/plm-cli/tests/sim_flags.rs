@@ -181,3 +181,14 @@ fn alarms_need_st7570_servers() {
     let err = refused(&["--chip", "st7570", "--alarms", "0"]);
     assert!(err.contains("--alarms"), "{err}");
 }
+
+#[test]
+fn factory_servers_need_st7570_servers() {
+    let err = refused(&["--factory-servers"]);
+    assert!(
+        err.contains("--factory-servers needs --chip st7570"),
+        "{err}"
+    );
+    let err = refused(&["--chip", "st7570", "--nodes", "1", "--factory-servers"]);
+    assert!(err.contains("there is no Server"), "{err}");
+}

@@ -11,6 +11,7 @@
 #![allow(dead_code, unused_imports)]
 
 pub mod latency;
+pub mod st7570;
 
 pub use plm_cli::rfc2217::client::{com_port, Client, Telnet};
 pub use plm_cli::rfc2217::control::{DTR_OFF, DTR_ON, RTS_OFF, RTS_ON};

@@ -2,7 +2,8 @@
 //! page, the console's modem as node 0 and Servers along the line that
 //! answer what is sent to them, every third a repeater
 //! ([`NetConfig::served_line`], the network `plm sim --chip st7570`
-//! serves). Its clock is the network's virtual time.
+//! serves, whose Servers take on the bit rate, f0 and f1 the console
+//! writes to its modem). Its clock is the network's virtual time.
 
 use super::{LinkState, Transport};
 use plm_core::st7570::MacSync;
