@@ -106,6 +106,62 @@ test('a truncated image is refused before anything is sent', async (t) => {
   assert.equal(await page.isDisabled('#update-start'), false);
 });
 
+/**
+ * A plain .bin as ST's toolchain writes it (UM 4.3): an STM32F103xB
+ * vector table (ECh bytes) for an image linked at `base` (08001000h
+ * after the bootloader, 08000000h without it), reserved words 0, then
+ * bytes standing for code.
+ */
+function plainBin(size, base = 0x0800_1000) {
+  const b = Buffer.alloc(size, 0x5a);
+  b.writeUInt32LE(0x2000_5000, 0);
+  for (let at = 4; at < 0xec; at += 4) {
+    const reserved = [0x1c, 0x20, 0x24, 0x28, 0x34].includes(at);
+    b.writeUInt32LE(reserved ? 0 : base + 0x200 + at + 1, at);
+  }
+  return b;
+}
+
+test('a plain .bin from the toolchain updates a lamp; one built without the bootloader is refused', async (t) => {
+  const page = await open(t);
+  await tab(page, 'update');
+  await page.setInputFiles('#update-file', {
+    name: 'standalone.bin',
+    mimeType: 'application/octet-stream',
+    buffer: plainBin(3000, 0x0800_0000),
+  });
+  const refused = page.locator('#update-image', { hasText: 'standalone.bin refused' });
+  await refused.waitFor();
+  assert.match(await refused.textContent(), /built without the bootloader/);
+  assert.equal(await page.isDisabled('#update-start'), true, 'nothing can be started');
+  await shot(page, 'update-plain-refused');
+
+  await page.setInputFiles('#update-file', {
+    name: 'PLM_HID_STANDALONE.bin',
+    mimeType: 'application/octet-stream',
+    buffer: plainBin(3000),
+  });
+  const taken = page.locator('#update-image', { hasText: 'PLM_HID_STANDALONE.bin: 3000 bytes' });
+  await taken.waitFor();
+  assert.match(await taken.textContent(), /names no release/);
+  // A release that is not x.y is refused before anything is sent.
+  await page.fill('#update-release', '2');
+  await page.selectOption('#update-targets', `lamp:${lamp(5)}`);
+  await page.click('#update-start');
+  await page.locator('#update-message', { hasText: "nothing sent: '2' is not a release" }).waitFor();
+  assert.equal(await page.locator('#update-progress-card').count(), 0, 'no campaign');
+  await page.fill('#update-release', '2.3');
+  await page.click('#update-start');
+  await summary(page, 'release 2.3 to 1 lamp(s): 1 updated, 0 not updated · took');
+  assert.match(await page.textContent('#update-boards tbody tr'), /updated to 2\.3/);
+  await shot(page, 'update-plain');
+  await tab(page, 'street');
+  await page.waitForFunction(
+    (sel) => document.querySelector(sel)?.textContent === '2.3',
+    `#fleet-table tr[data-address="${lamp(5)}"] td[data-key="firmware"]`,
+  );
+});
+
 test('a street of 10 with one lamp unreachable: the others updated, that one reported', async (t) => {
   const page = await open(t, 10);
   await page.click(`#fleet-table tbody tr[data-address="${lamp(7)}"]`);

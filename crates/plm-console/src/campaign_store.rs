@@ -57,8 +57,8 @@ pub fn describe() -> String {
     };
     match plm_core::app::update::Update::resume(image, &progress, 0) {
         Ok(u) => format!(
-            "release {} to {} lamp(s), {}-byte image",
-            u.header().version,
+            "{} to {} lamp(s), {}-byte image",
+            plm_core::app::rfu::release_words(u.header().release()),
             u.boards().count(),
             u.header().size
         ),
