@@ -2,7 +2,9 @@
 //! (IEC 61334-5-1, ST7570 UM 3.2 and 4.4) through the real binary. The
 //! frames are built here byte by byte from the layout recorded in
 //! docs/protocol-notes.md ("ST7570: MAC and PHY frames on the line"), with
-//! an FCS computed by this file's own bitwise CRC-24, not by plm-core.
+//! an FCS computed by this file's own bitwise CRC-24, not by plm-core;
+//! and the line vectors of tests/vectors/st7570_line.jsonl (written by
+//! tests/vectors/make_st7570_line.py), each FCS form named.
 
 use serde_json::{json, Value};
 mod common;
@@ -71,6 +73,7 @@ fn a_long_mac_frame_by_name() {
             "pad_bytes": "",
             "fcs": 0xFF3B89,
             "fcs_ok": true,
+            "fcs_form": "catalogue",
         })
     );
 }
@@ -124,6 +127,54 @@ fn a_damaged_frame_is_shown_with_its_fcs_wrong() {
     assert_eq!(v["fcs"], 0xFF3B89);
     let e = v["error"].as_str().unwrap();
     assert!(e.starts_with("bad FCS: received FF3B89h"), "{e}");
+}
+
+/// A frame written the way Gurux's DLMS library writes it decodes with its
+/// FCS form named (over the pad bytes, as its C and C# writers send it, or
+/// without them, as its writer's FCS length reads); the catalogue form
+/// this project sends is named too; a frame neither explains is flagged
+/// with each form's FCS in the error.
+#[test]
+fn every_fcs_form_of_the_line_vectors_is_named() {
+    const VECTORS: &str = include_str!("../../../tests/vectors/st7570_line.jsonl");
+    let mut forms = Vec::new();
+    for text in VECTORS.lines().filter(|l| !l.trim().is_empty()) {
+        let v: Value = serde_json::from_str(text).unwrap();
+        let name = v["name"].as_str().unwrap();
+        let got = decode(
+            &[
+                "decode",
+                "--chip",
+                "st7570",
+                "--line",
+                v["hex"].as_str().unwrap(),
+            ],
+            None,
+        );
+        assert_eq!(got.len(), 1, "{name}: one object");
+        let got = &got[0];
+        for (k, want) in v["expect"].as_object().unwrap() {
+            let error = got["error"].as_str().unwrap_or("");
+            match k.as_str() {
+                "error_starts" => {
+                    assert!(error.starts_with(want.as_str().unwrap()), "{name}: {error}")
+                }
+                "error_mentions" => {
+                    for m in want.as_array().unwrap() {
+                        assert!(
+                            error.contains(m.as_str().unwrap()),
+                            "{name}: {error} lacks {m}"
+                        );
+                    }
+                }
+                _ => assert_eq!(got.get(k).unwrap_or(&Value::Null), want, "{name}: {k}"),
+            }
+        }
+        forms.push(got["fcs_form"].as_str().unwrap_or("none").to_string());
+    }
+    for form in ["catalogue", "gurux", "gurux_without_pad", "none"] {
+        assert!(forms.iter().any(|f| f == form), "no vector in form {form}");
+    }
 }
 
 #[test]

@@ -6,8 +6,8 @@
 //! frame is refused.
 
 use plm_core::st7570::mac::{
-    self, fcs, LongFrame, MacError, MacFrame, CHUNK_LEN, FCS_ALGORITHM, LONG_MAC_FRAME, MAX_M_SDU,
-    SUBFRAME_LEN,
+    self, fcs, gurux_fcs, FcsForm, LongFrame, MacError, MacFrame, CHUNK_LEN, FCS_ALGORITHM,
+    LONG_MAC_FRAME, MAX_M_SDU, SUBFRAME_LEN,
 };
 use plm_core::st7570::phy_frame::{self, LineKind, PhyFrame, Window, PHY_FRAME_LEN};
 use plm_core::st7570::{Address, Credit};
@@ -54,6 +54,7 @@ fn seed_10_3_mac_frame_on_the_line() {
     let view = LongFrame::new_checked(&long).unwrap();
     assert_eq!(view.pad_len(), 0, "10.3.2: PAD 00h");
     assert!(view.fcs_ok());
+    assert_eq!(view.fcs_form(), Ok(FcsForm::Catalogue));
     assert_eq!(MacFrame::parse_bytes(&long).unwrap(), f);
 
     // One subframe: FI 0000h and the 36 bytes; one PHY frame.
@@ -251,10 +252,61 @@ fn every_m_sdu_length_round_trips() {
     }
 }
 
+/// `long` with its FCS replaced by `value`.
+fn with_fcs(mut long: Vec<u8>, value: u32) -> Vec<u8> {
+    let at = long.len() - 3;
+    long[at..].copy_from_slice(&value.to_be_bytes()[1..]);
+    long
+}
+
+#[test]
+fn a_gurux_fcs_is_named_but_the_simulated_modems_refuse_it() {
+    // 40 bytes of M_sdu: two subframes, 22 pad bytes (docs/protocol-notes.md:
+    // the simulated receivers accept the catalogue form only).
+    let f = frame(3, 3, 0, 0xC00, 0xFFF, (0..40).collect());
+    let long = f.emit().unwrap();
+    let body = &long[2..long.len() - 3];
+    for (value, form) in [
+        (gurux_fcs(body), FcsForm::Gurux),
+        (
+            gurux_fcs(&body[..body.len() - 22]),
+            FcsForm::GuruxWithoutPad,
+        ),
+    ] {
+        let g = with_fcs(long.clone(), value);
+        let view = LongFrame::new_checked(&g).unwrap();
+        assert_eq!(view.fcs_form(), Ok(form));
+        assert!(!view.fcs_ok());
+        let e = MacFrame::parse(&view).unwrap_err();
+        assert!(matches!(e, MacError::Fcs { .. }), "{e}");
+    }
+    // No form: the error gives each one's FCS.
+    let bad = with_fcs(long.clone(), fcs(body) ^ 1);
+    let e = LongFrame::new_checked(&bad)
+        .unwrap()
+        .fcs_form()
+        .unwrap_err();
+    let text = e.to_string();
+    assert!(text.starts_with("bad FCS: received"), "{text}");
+    for v in [
+        fcs(body),
+        gurux_fcs(body),
+        gurux_fcs(&body[..body.len() - 22]),
+    ] {
+        assert!(text.contains(&format!("{v:06X}h")), "{text}");
+    }
+}
+
 proptest! {
     #[test]
     fn mac_frames_round_trip(f in mac_frame(1..=MAX_M_SDU), fi in any::<u16>()) {
         round_trips(&f, fi);
+    }
+
+    #[test]
+    fn emitted_frames_carry_the_catalogue_form(f in mac_frame(1..=MAX_M_SDU)) {
+        let long = f.emit().unwrap();
+        prop_assert_eq!(LongFrame::new_checked(&long).unwrap().fcs_form(), Ok(FcsForm::Catalogue));
     }
 
     #[test]

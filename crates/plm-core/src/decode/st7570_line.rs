@@ -11,7 +11,10 @@
 //! - `ns`: the number of subframes; `fields`: the header by the names of
 //!   Table 38 (`ic`, `cc`, `dc`, `sa`, `da` with `sa_group`/`da_group`
 //!   for Table 6's groups, `pad`);
-//! - `m_sdu` and the `pad_bytes`, hex; `fcs` and `fcs_ok`.
+//! - `m_sdu` and the `pad_bytes`, hex; `fcs`, `fcs_ok` and `fcs_form`,
+//!   the form of FCS the frame carries ([`mac::FcsForm`]: `catalogue`,
+//!   `gurux` or `gurux_without_pad`); a frame whose FCS is in none of them
+//!   has `fcs_ok: false`, no `fcs_form` and `error` with each form's FCS.
 //!
 //! The layout is [`crate::st7570::mac`]'s; nothing is read here.
 
@@ -45,8 +48,10 @@ pub struct LineDecoded {
     pub pad_bytes: Option<String>,
     /// The FCS as received.
     pub fcs: Option<u32>,
-    /// Whether the FCS is the frame's.
+    /// Whether the FCS is the frame's in one of the known forms.
     pub fcs_ok: Option<bool>,
+    /// The form it is in (`catalogue`, `gurux`, `gurux_without_pad`).
+    pub fcs_form: Option<String>,
     /// Why the bytes are not a frame, in words.
     pub error: Option<String>,
 }
@@ -63,6 +68,7 @@ json_record!(LineDecoded {
     pad_bytes,
     fcs,
     fcs_ok,
+    fcs_form,
     error,
 });
 
@@ -75,8 +81,8 @@ fn window(w: Window) -> Json {
 }
 
 /// Decodes a long MAC frame, MAC subframes or PHY frames from the line.
-/// A frame whose FCS is wrong is shown with `fcs_ok: false`; bytes that
-/// are none of the three are `garbage` with the reason.
+/// A frame whose FCS is in no known form is shown with `fcs_ok: false`;
+/// bytes that are none of the three are `garbage` with the reason.
 pub fn decode_line(bytes: &[u8]) -> LineDecoded {
     let mut d = LineDecoded {
         kind: "garbage".to_string(),
@@ -89,6 +95,7 @@ pub fn decode_line(bytes: &[u8]) -> LineDecoded {
         pad_bytes: None,
         fcs: None,
         fcs_ok: None,
+        fcs_form: None,
         error: None,
     };
     let line = match phy_frame::decode(bytes) {
@@ -119,9 +126,15 @@ pub fn decode_line(bytes: &[u8]) -> LineDecoded {
     d.m_sdu = Some(hex::encode(frame.m_sdu()));
     d.pad_bytes = Some(hex::encode(frame.pad()));
     d.fcs = Some(frame.fcs());
-    d.fcs_ok = Some(frame.fcs_ok());
-    if !frame.fcs_ok() {
-        d.error = mac::MacFrame::parse(&frame).err().map(|e| e.to_string());
+    match frame.fcs_form() {
+        Ok(form) => {
+            d.fcs_ok = Some(true);
+            d.fcs_form = Some(form.name().to_string());
+        }
+        Err(e) => {
+            d.fcs_ok = Some(false);
+            d.error = Some(e.to_string());
+        }
     }
     d
 }
@@ -145,7 +158,7 @@ mod tests {
             "{\"kind\":\"mac_frame\",\"hex\":\"6c6c00c0000100000102030405060708090a0b0c0d0e0f10111213141516171819ff3b89\",\
              \"ns\":1,\"fields\":{\"ic\":0,\"cc\":0,\"dc\":0,\"sa\":3072,\"da\":1,\"pad\":0},\
              \"m_sdu\":\"000102030405060708090a0b0c0d0e0f10111213141516171819\",\"pad_bytes\":\"\",\
-             \"fcs\":16726921,\"fcs_ok\":true}"
+             \"fcs\":16726921,\"fcs_ok\":true,\"fcs_form\":\"catalogue\"}"
         );
     }
 

@@ -12,9 +12,10 @@
 //!
 //! CREDIT, ADDRESS and PAD are the bytes of Table 38 ([`mac_data`]), two
 //! bytes further on. Two levels, after smoltcp: [`LongFrame`] is a checked
-//! view over the bytes (it also shows a frame whose FCS is wrong), and
-//! [`MacFrame`] the validated typed frame with `parse` and `emit`. Nothing
-//! here panics on any input.
+//! view over the bytes (it also shows a frame whose FCS is wrong, and says
+//! which of the known [`FcsForm`]s it carries), and [`MacFrame`] the
+//! validated typed frame with `parse` and `emit`. Nothing here panics on
+//! any input.
 
 use super::fields::{mac_data, P_SDU_LEN};
 use super::types::{Address, Credit};
@@ -62,6 +63,52 @@ const FCS: Crc<u32, CrcImpl> = Crc::<u32, CrcImpl>::new(&FCS_ALGORITHM);
 /// The FCS of `bytes` (in a long frame: CREDIT up to the last pad byte).
 pub fn fcs(bytes: &[u8]) -> u32 {
     FCS.checksum(bytes)
+}
+
+/// The FCS of `bytes` in Gurux's register form: the remainder of the
+/// message itself (not of message·x^24) by the same polynomial, its 24
+/// bits reversed; sent MSByte first like ours. No CRC catalogue lists it
+/// (docs/protocol-notes.md, "ST7570: MAC and PHY frames on the line").
+pub fn gurux_fcs(bytes: &[u8]) -> u32 {
+    let mut r: u32 = 0;
+    for b in bytes {
+        for i in (0..8).rev() {
+            let out = r >> 23 & 1;
+            r = (r << 1 | (*b as u32 >> i & 1)) & 0xFF_FFFF;
+            if out == 1 {
+                r ^= FCS_ALGORITHM.poly;
+            }
+        }
+    }
+    r.reverse_bits() >> 8
+}
+
+/// The forms of FCS a long frame on the line may carry: the two
+/// IEC 61334-5-1 encoders known write different ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FcsForm {
+    /// [`fcs`] over CREDIT up to the last pad byte: the catalogue CRC-24
+    /// this project sends, and the only form its simulated modems accept.
+    Catalogue,
+    /// [`gurux_fcs`] over the same bytes: what Gurux's C and C# writers
+    /// send (their pad count is spent by the loop that writes the pad
+    /// bytes before the FCS length is taken).
+    Gurux,
+    /// [`gurux_fcs`] over CREDIT up to the last M_sdu byte, the pad bytes
+    /// left out, as Gurux's writer's FCS length reads. The same as
+    /// [`FcsForm::Gurux`] for a frame without pad bytes.
+    GuruxWithoutPad,
+}
+
+impl FcsForm {
+    /// Its name in `plm decode` output.
+    pub fn name(self) -> &'static str {
+        match self {
+            FcsForm::Catalogue => "catalogue",
+            FcsForm::Gurux => "gurux",
+            FcsForm::GuruxWithoutPad => "gurux_without_pad",
+        }
+    }
 }
 
 /// The field layout of a long MAC frame's header, for decoders and forms.
@@ -135,6 +182,17 @@ pub enum MacError {
         /// As computed.
         computed: u32,
     },
+    /// The FCS received is none of the known forms' ([`FcsForm`]).
+    FcsForms {
+        /// As received.
+        received: u32,
+        /// The catalogue form's.
+        catalogue: u32,
+        /// Gurux's, over the pad bytes.
+        gurux: u32,
+        /// Gurux's without the pad bytes, when there are any.
+        gurux_without_pad: Option<u32>,
+    },
     /// Subframes whose bytes are not a whole number of 38-byte subframes.
     SubframeLength(usize),
     /// A number of subframes outside 1..=7.
@@ -186,6 +244,25 @@ impl fmt::Display for MacError {
                 f,
                 "bad FCS: received {received:06X}h, the frame's is {computed:06X}h"
             ),
+            MacError::FcsForms {
+                received,
+                catalogue,
+                gurux,
+                gurux_without_pad,
+            } => {
+                write!(
+                    f,
+                    "bad FCS: received {received:06X}h, in no known form: the frame's would be \
+                     {catalogue:06X}h (catalogue)"
+                )?;
+                match gurux_without_pad {
+                    Some(g) => write!(
+                        f,
+                        ", {gurux:06X}h (Gurux) or {g:06X}h (Gurux without the pad bytes)"
+                    ),
+                    None => write!(f, " or {gurux:06X}h (Gurux)"),
+                }
+            }
             MacError::SubframeLength(n) => {
                 write!(f, "{n} bytes is not a whole number of 38-byte subframes")
             }
@@ -287,9 +364,35 @@ impl<'a> LongFrame<'a> {
         fcs(&self.bytes[2..self.fcs_at()])
     }
 
-    /// Whether the FCS received is the frame's.
+    /// Whether the FCS received is the frame's in the catalogue form, the
+    /// one this project sends and its simulated modems accept.
     pub fn fcs_ok(&self) -> bool {
         self.fcs() == self.computed_fcs()
+    }
+
+    /// Which known form the FCS received is in, or, when it is in none,
+    /// what each form's would be.
+    pub fn fcs_form(&self) -> Result<FcsForm, MacError> {
+        let received = self.fcs();
+        let body = &self.bytes[2..self.fcs_at()];
+        let catalogue = self.computed_fcs();
+        let gurux = gurux_fcs(body);
+        let gurux_without_pad =
+            (self.pad_len() > 0).then(|| gurux_fcs(&body[..body.len() - self.pad_len()]));
+        if received == catalogue {
+            Ok(FcsForm::Catalogue)
+        } else if received == gurux {
+            Ok(FcsForm::Gurux)
+        } else if Some(received) == gurux_without_pad {
+            Ok(FcsForm::GuruxWithoutPad)
+        } else {
+            Err(MacError::FcsForms {
+                received,
+                catalogue,
+                gurux,
+                gurux_without_pad,
+            })
+        }
     }
 }
 
@@ -418,6 +521,32 @@ pub fn subframes_of(bytes: &[u8]) -> Result<Vec<[u8; SUBFRAME_LEN]>, MacError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The remainder of `bytes`·x^`shift` by the generator, long division
+    /// on a whole number (a different computation from both FCS
+    /// functions).
+    fn remainder(bytes: &[u8], shift: u32) -> u32 {
+        const G: u128 = 1 << 24 | 0x5D_6DCB;
+        let mut m = bytes.iter().fold(0u128, |m, b| m << 8 | *b as u128) << shift;
+        while m >> 24 != 0 {
+            m ^= G << (127 - m.leading_zeros() - 24);
+        }
+        m as u32
+    }
+
+    #[test]
+    fn both_fcs_forms_are_remainders_of_the_generator() {
+        // Catalogue: message·x^24 mod G. Gurux: message mod G, bits
+        // reversed. 13 bytes at most: the dividend fits 128 bits.
+        for msg in [&b"123456789"[..], &[0x00], &[0xFF; 13], &[0x80, 0, 0, 1]] {
+            assert_eq!(fcs(msg), remainder(msg, 24), "{msg:02x?}");
+            let r = remainder(msg, 0);
+            assert_eq!(gurux_fcs(msg), r.reverse_bits() >> 8, "{msg:02x?}");
+        }
+        assert_eq!(fcs(b"123456789"), FCS_ALGORITHM.check);
+        // Three bytes or fewer are their own remainder.
+        assert_eq!(gurux_fcs(&[0x00, 0x00, 0x01]), 0x80_0000);
+    }
 
     #[test]
     fn ns_codes_are_a_simplex_code() {
