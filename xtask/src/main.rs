@@ -4,6 +4,8 @@
 //! fresh machine needs only Rust and `cargo xtask serve` or `cargo xtask test`.
 
 mod bench;
+#[cfg(test)]
+mod doc_toc;
 mod serve;
 mod setup;
 mod test;
