@@ -159,6 +159,18 @@ struct SimArgs {
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Every lamp breaks this rule of the board protocol
+    /// (docs/board-protocol.md), to show `plm board conformance`
+    /// catching it. For tests: hidden from --help.
+    #[arg(long = "break", value_name = "RULE", hide = true, value_parser = parse_breach)]
+    breach: Option<plm_sim::breach::Breach>,
+}
+
+fn parse_breach(s: &str) -> Result<plm_sim::breach::Breach, String> {
+    plm_sim::breach::Breach::named(s).ok_or_else(|| {
+        let names: Vec<&str> = plm_sim::breach::BREACHES.iter().map(|b| b.0).collect();
+        format!("'{s}' is not a rule to break: one of {}", names.join(", "))
+    })
 }
 
 /// The MIB of `plm sim`'s echoing peers.
@@ -236,6 +248,7 @@ fn st7570_world(args: &SimArgs) -> Result<sim_server::World, String> {
         (args.peers.is_some(), "--peers"),
         (args.cold_lamps, "--cold-lamps"),
         (args.lamp_failures > 0.0, "--lamp-failures"),
+        (args.breach.is_some(), "--break"),
     ] {
         if given {
             return Err(format!(
@@ -293,17 +306,21 @@ fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
             attach: plm_sim::Attach::Board,
             cold: args.cold_lamps,
             failures: args.lamp_failures,
+            breach: args.breach,
         },
         (false, Some(n)) => sim_server::World::Street {
             lamps: n.into(),
             attach: plm_sim::Attach::Modem,
             cold: args.cold_lamps,
             failures: args.lamp_failures,
+            breach: args.breach,
         },
-        (false, None) if args.cold_lamps || args.lamp_failures > 0.0 => return Err(
-            "--cold-lamps and --lamp-failures need a street of lamps: add --street N or --board"
-                .into(),
-        ),
+        (false, None) if args.cold_lamps || args.lamp_failures > 0.0 || args.breach.is_some() => {
+            return Err(
+                "--cold-lamps, --lamp-failures and --break need a street of lamps: add --street N or --board"
+                    .into(),
+            )
+        }
         (false, None) => {
             let nodes = args.nodes.unwrap_or(args.serve);
             if nodes < args.serve {

@@ -98,6 +98,8 @@ pub enum World {
         /// Random lamp failures per lamp per lit hour (0: none;
         /// `BallastConfig::failure_rate_per_lit_hour`).
         failures: f64,
+        /// A rule of the board protocol every lamp breaks (`--break`).
+        breach: Option<plm_sim::breach::Breach>,
     },
 }
 
@@ -189,6 +191,7 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             attach,
             cold,
             failures,
+            breach,
         } => (
             {
                 let street = SimConfig::street(lamps, attach);
@@ -198,6 +201,7 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
                         failure_rate_per_lit_hour: failures,
                         ..street.ballast.clone()
                     },
+                    breach,
                     ..street
                 }
             },
@@ -244,6 +248,16 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
                 Peers::EchoFollowing => "with node 0's MIB 00h/01h (as its host writes them)",
                 _ => "with the factory MIB (--peers factory)",
             }
+        ));
+    }
+    if let World::Street {
+        breach: Some(b), ..
+    } = opts.world
+    {
+        let name = plm_sim::breach::BREACHES.iter().find(|x| x.1 == b);
+        banner.push(format!(
+            "plm sim: every lamp breaks the board protocol's rule `{}` (--break)",
+            name.map_or("?", |x| x.0)
         ));
     }
     banner.push(

@@ -16,6 +16,7 @@
 //! line frames for it come back on the USART with the sender's address.
 
 use crate::ballast::{BallastConfig, HidBallast, Reply};
+use crate::breach::Breach;
 use crate::rfu::{self, RfuManager};
 use crate::rng::Rng;
 use plm_core::app::concentrator::USART_IDLE;
@@ -103,6 +104,8 @@ pub struct Board {
     usart_out: VecDeque<Vec<u8>>,
     /// Remote firmware update, with the board's flash.
     rfu: RfuManager,
+    /// The board protocol rule it breaks, if any (`plm sim --break`).
+    breach: Option<Breach>,
     /// Frames handled (for tests and views).
     pub handled: u64,
 }
@@ -139,6 +142,7 @@ impl Board {
             usart_last: None,
             usart_out: VecDeque::new(),
             rfu: RfuManager::factory(now, FIRMWARE),
+            breach: None,
             handled: 0,
         }
     }
@@ -176,6 +180,12 @@ impl Board {
     /// The same board with a USART to the outside host (a concentrator).
     pub fn with_usart(mut self) -> Self {
         self.usart = Some(UsartDecoder::new());
+        self
+    }
+
+    /// The same board breaking one rule of the board protocol.
+    pub fn with_breach(mut self, breach: Option<Breach>) -> Self {
+        self.breach = breach;
         self
     }
 
@@ -348,6 +358,26 @@ impl Board {
     /// The application engine: what this board answers `frame` from
     /// `from`; broadcasts are carried out and not answered.
     fn handle(
+        &mut self,
+        now: Instant,
+        from: Address,
+        broadcast: bool,
+        frame: &AppFrame,
+        rng: &mut Rng,
+    ) -> Option<Message> {
+        let Some(breach) = self.breach else {
+            return self.respond(now, from, broadcast, frame, rng);
+        };
+        let m = Message::of(frame).ok();
+        if m.as_ref().is_some_and(|m| breach.ignores(m)) {
+            return None;
+        }
+        let answer = self.respond(now, from, broadcast, frame, rng);
+        breach.answer(m.as_ref(), answer)
+    }
+
+    /// What a board that keeps every rule answers.
+    fn respond(
         &mut self,
         now: Instant,
         from: Address,

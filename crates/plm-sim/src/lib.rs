@@ -19,7 +19,8 @@
 //! - [`echo`]: the echoing host of simulated peers.
 //! - [`ballast`]: the HID ballast of a board and its lamp model.
 //! - [`board`]: the street-light controller board (STEVAL-IHP007V1) whose
-//!   firmware drives its modem, and a concentrator board's USART.
+//!   firmware drives its modem, and a concentrator board's USART;
+//!   [`breach`]: one that breaks a rule of the board protocol, on demand.
 //! - [`drive`]: plm-core's host engine driving node 0 in virtual time.
 //! - [`ports`]: the served nodes' UARTs, as `plm sim` reaches them.
 //! - [`street`]: plm-core's concentrator driving a street in virtual time.
@@ -29,6 +30,7 @@
 
 pub mod ballast;
 pub mod board;
+pub mod breach;
 pub mod drive;
 pub mod echo;
 pub mod flash;

@@ -14,6 +14,7 @@
 
 use crate::ballast::BallastConfig;
 use crate::board::{street_address, Board, BoardConfig};
+use crate::breach::Breach;
 use crate::echo::EchoHost;
 use crate::line::{self, LineConfig, Transmission};
 use crate::modem::{Reception, St7580};
@@ -50,6 +51,10 @@ pub struct SimConfig {
     /// The modulation the street's boards (and a concentrator board)
     /// send with (their firmware's TxParams; B-PSK by default).
     pub modulation: Modulation,
+    /// A rule of the board protocol every street board breaks (to show
+    /// `plm board conformance` catching it); `None` for a street that
+    /// keeps them all.
+    pub breach: Option<Breach>,
 }
 
 impl Default for SimConfig {
@@ -64,6 +69,7 @@ impl Default for SimConfig {
             served: 1,
             ballast: BallastConfig::default(),
             modulation: Modulation::BPsk,
+            breach: None,
         }
     }
 }
@@ -381,7 +387,9 @@ impl Sim {
                             ballast.lifetime_hours = rng.below(8_000) as u16;
                             ballast.power_ons = ballast.lifetime_hours / 11 + 1;
                         }
-                        Host::Board(Box::new(board(Some(ballast), offset)))
+                        Host::Board(Box::new(
+                            board(Some(ballast), offset).with_breach(config.breach),
+                        ))
                     }
                 };
                 Node {

@@ -1,7 +1,8 @@
 //! `plm board`: talk to street-light controller boards (STEVAL-IHP007V1)
 //! through a concentrator board's USART or a bare ST7580, on a serial
 //! device or an `rfc2217://` port: discover, status, dimming, remote
-//! firmware update, and simulated images to try it on `plm sim`.
+//! firmware update, simulated images to try it on `plm sim`, and a
+//! board's conformance to the board protocol.
 //!
 //! Everything on the wire is plm-core's ([`plm_core::app`]): the
 //! concentrator, discovery, the requester and the update engine. This
@@ -24,6 +25,7 @@ macro_rules! tell {
     }};
 }
 
+mod conformance;
 pub mod driver;
 mod info;
 mod rfu;
@@ -40,7 +42,8 @@ use std::path::PathBuf;
 pub mod exit {
     /// Every board targeted answered (or was updated).
     pub const OK: u8 = 0;
-    /// Some board failed, refused, or did not answer.
+    /// Some board failed, refused, or did not answer (conformance: a
+    /// rule failed or could not be checked).
     pub const FAILED: u8 = 1;
     /// The command line is wrong (clap's own code).
     pub const USAGE: u8 = 2;
@@ -56,7 +59,7 @@ pub mod exit {
 pub const EXIT_CODES: &str = "\
 Exit codes:
   0    success: every board targeted answered (rfu: every board updated)
-  1    some boards failed, refused or did not answer
+  1    some boards failed, refused or did not answer (conformance: a rule failed or was not checked)
   2    usage error (wrong arguments)
   3    the port could not be opened, or was lost
   4    bad image or state file (nothing was sent)
@@ -173,6 +176,14 @@ pub enum BoardCommand {
         #[arg(value_parser = clap::value_parser!(u8).range(0..=100))]
         level: u8,
     },
+    /// Check one board against the board protocol this project defines
+    /// (discovery, RFU; docs/board-protocol.md): each rule passed, failed
+    /// or not checked, in words. It never changes what the board runs.
+    Conformance {
+        /// The board's address (12 hex digits, e.g. 0080e1000001).
+        #[arg(value_parser = parse_address)]
+        node: Address,
+    },
     /// Remote firmware update of boards over the line, resumable.
     Rfu(RfuArgs),
     /// Write a simulated firmware image (what `plm sim`'s boards take),
@@ -281,6 +292,10 @@ fn dispatch(args: BoardArgs) -> Result<u8, Failure> {
         BoardCommand::Dim { target, level } => {
             let mut d = connect(&args)?;
             info::dim(&mut d, *target, *level, args.json)
+        }
+        BoardCommand::Conformance { node } => {
+            let mut d = connect(&args)?;
+            conformance::run(&mut d, *node, args.json)
         }
         BoardCommand::Rfu(r) => rfu::run(&args, r),
         BoardCommand::Image(a) => rfu::write_image(a),
