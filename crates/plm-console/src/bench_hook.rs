@@ -33,7 +33,7 @@ pub fn install(c: Console) {
     };
     let hook = Object::new();
     let set_baud = Closure::<dyn Fn(u32) -> u32>::new(move |baud: u32| {
-        if plm_sim::BAUD_RATES.contains(&baud) {
+        if plm_core::link::BAUD_RATES.contains(&baud) {
             c.set_baud(baud);
         }
         c.conn.baud.get_untracked()

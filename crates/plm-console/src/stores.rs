@@ -354,7 +354,7 @@ impl Console {
                 _ => Concentrator::modem(
                     RequesterConfig::default(),
                     baud,
-                    plm_sim::board::street_address(0),
+                    Concentrator::ADDRESS,
                     TxParams::default(),
                 ),
             };

@@ -711,8 +711,8 @@ mod tests {
             }
 
             let t = s.transport_mut().unwrap().simulator().unwrap();
-            t.lamp(5, LampAction::Fail);
-            t.lamp(8, LampAction::Cut);
+            t.lamp(street_address(5), LampAction::Fail);
+            t.lamp(street_address(8), LampAction::Cut);
             let alerts = run(&mut s, 60 * S);
             let about = |n: usize| {
                 alerts

@@ -611,3 +611,16 @@ impl Board {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The host's default address as a bare-modem concentrator is the
+    /// simulated street's node 0: the console and `plm board` need no
+    /// fact of the simulator to reach it.
+    #[test]
+    fn node_0_is_the_concentrators_default_address() {
+        assert_eq!(street_address(0), plm_core::app::Concentrator::ADDRESS);
+    }
+}

@@ -3,7 +3,6 @@
 //! `plm board` with a serial port, done as fast as possible, over either
 //! way in ([`Attach`]). Tests and `cargo xtask bench` use it.
 
-use crate::board::street_address;
 use crate::sim::{Attach, Sim};
 use plm_core::app::{
     Address, AppEvent, Concentrator, Discovery, Happening, Message, Request, RequestId,
@@ -41,9 +40,12 @@ impl StreetDriver {
     fn concentrator(sim: &Sim, config: RequesterConfig) -> Concentrator {
         match sim.attach() {
             Attach::Board => Concentrator::usart(config),
-            Attach::Modem => {
-                Concentrator::modem(config, sim.baud(), street_address(0), TxParams::default())
-            }
+            Attach::Modem => Concentrator::modem(
+                config,
+                sim.baud(),
+                Concentrator::ADDRESS,
+                TxParams::default(),
+            ),
         }
     }
 

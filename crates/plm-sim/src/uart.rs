@@ -12,8 +12,7 @@ use crate::rng::Rng;
 use plm_core::time::{wire_time, Duration, Instant, MS};
 use std::collections::VecDeque;
 
-/// Baud rates the ST7580 takes from its BR0/BR1 pins (UM0932 Table 5).
-pub const BAUD_RATES: [u32; 4] = [9_600, 19_200, 38_400, 57_600];
+pub use plm_core::link::BAUD_RATES;
 
 /// Faults applied at random to every byte, with these probabilities.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -135,7 +135,7 @@ pub struct BoardArgs {
     pub baud: u32,
     /// With --via modem: this concentrator's own 6-byte address on the
     /// line (12 hex digits).
-    #[arg(long, global = true, default_value = "0080E1000000", value_parser = parse_address)]
+    #[arg(long, global = true, default_value_t = Concentrator::ADDRESS, value_parser = parse_address)]
     pub address: Address,
     /// Print JSON lines on stdout instead of words (discover, status,
     /// dim, rfu's results).

@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 /// Baud rates the BR0/BR1 pins select: UM0932 3.1 for the ST7580, the
 /// same four in the ST7570 UM's Table 9.
-pub const RATES: &[u32] = &plm_sim::BAUD_RATES;
+pub const RATES: &[u32] = &plm_core::link::BAUD_RATES;
 
 /// What wakes the loop.
 enum Wake {

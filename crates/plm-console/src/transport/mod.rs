@@ -12,6 +12,7 @@ pub mod sim;
 #[cfg(target_arch = "wasm32")]
 pub mod webserial;
 
+use plm_core::app::Address;
 use plm_core::time::{Duration, Instant};
 use plm_sim::{Fault, LineConfig, LineEvent};
 
@@ -109,9 +110,10 @@ pub trait Simulator {
     fn plugged(&self) -> bool;
     /// Line events since the last call, oldest first.
     fn line_events(&mut self) -> Vec<LineEvent>;
-    /// Does something to the lamp of street node `node` (1..): faults on
-    /// demand for demos and tests.
-    fn lamp(&mut self, node: usize, action: LampAction);
+    /// Does something to the simulated lamp at `address` (nothing when
+    /// no lamp of the street has it): faults on demand for demos and
+    /// tests.
+    fn lamp(&mut self, address: Address, action: LampAction);
     /// Random lamp failures from now on, per lamp per lit hour (0: none),
     /// on every lamp of a simulated street.
     fn set_failure_rate(&mut self, per_lit_hour: f64);

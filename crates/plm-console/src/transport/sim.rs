@@ -3,7 +3,9 @@
 //! virtual time, which the session moves on in step with the page's clock.
 
 use super::{LampAction, LinkState, Simulator, Transport};
+use plm_core::app::Address;
 use plm_core::time::Instant;
+use plm_sim::board::street_address;
 use plm_sim::{Attach, ByteFaults, Dir, Fault, LineConfig, LineEvent, Sim, SimConfig};
 
 /// A simulated modem on node 0 of a simulated power line.
@@ -151,7 +153,10 @@ impl Simulator for SimTransport {
         }
     }
 
-    fn lamp(&mut self, node: usize, action: LampAction) {
+    fn lamp(&mut self, address: Address, action: LampAction) {
+        let Some(node) = (1..self.sim.nodes()).find(|&n| street_address(n) == address) else {
+            return;
+        };
         let cut = match action {
             LampAction::Cut => Some(true),
             LampAction::Join => Some(false),

@@ -13,7 +13,7 @@ use crate::profile::Profile;
 use crate::stores::use_console;
 use crate::transport::LinkState;
 use leptos::prelude::*;
-use plm_sim::BAUD_RATES;
+use plm_core::link::BAUD_RATES;
 
 /// The bar.
 #[component]

@@ -163,10 +163,9 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
         let Some(a) = focus.get_untracked() else {
             return;
         };
-        let node = (a.to_u64() - plm_sim::board::ADDRESS_BASE) as usize;
         street.act(|s| {
             if let Some(sim) = s.transport_mut().and_then(|t| t.simulator()) {
-                sim.lamp(node, action);
+                sim.lamp(a, action);
             }
         });
         note.set(Some(format!("simulator: {} on this lamp", action.label())));

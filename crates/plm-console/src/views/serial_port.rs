@@ -39,7 +39,7 @@ mod wasm {
         checkbox, escape, html, live_button, on_click, option_html, select, text,
     };
     use leptos::prelude::*;
-    use plm_sim::BAUD_RATES;
+    use plm_core::link::BAUD_RATES;
     use std::rc::Rc;
     use wasm_bindgen::closure::Closure;
     use wasm_bindgen::{JsCast, JsValue};

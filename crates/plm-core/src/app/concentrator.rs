@@ -81,6 +81,11 @@ pub struct Concentrator {
 }
 
 impl Concentrator {
+    /// The host's own address on the line when a bare modem is the
+    /// concentrator, unless the user gives another (decided here:
+    /// ST's prefix 0080E1h and node 0; docs/protocol-notes.md).
+    pub const ADDRESS: Address = Address([0x00, 0x80, 0xE1, 0x00, 0x00, 0x00]);
+
     /// Through a concentrator board's USART.
     pub fn usart(config: RequesterConfig) -> Self {
         Self::with(

@@ -13,6 +13,10 @@ mod rx;
 mod timeouts;
 
 pub use dialect::{Answer, Dialect, Reaction};
+
+/// Baud rates of the host UART, chosen by the BR1/BR0 pins at reset: the
+/// same four on both chips (UM0932 Table 5, ST7570 UM Table 9).
+pub const BAUD_RATES: [u32; 4] = [9_600, 19_200, 38_400, 57_600];
 pub use element::{Element, GarbageReason, Source, StatusMessage};
 pub use frame::{checksum, EmitError, Frame, FrameError, LocalFrame, Stx};
 pub use stream::StreamDecoder;

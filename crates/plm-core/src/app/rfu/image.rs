@@ -215,7 +215,7 @@ fn check_vectors(image: &[u8]) -> Result<(), String> {
     let not_stm32 = "not an STM32F103 application image";
     let sp = word(image, 0);
     let (sram, sram_end) = SRAM;
-    if sp <= sram || sp > sram_end || sp % 4 != 0 {
+    if sp <= sram || sp > sram_end || !sp.is_multiple_of(4) {
         return Err(format!(
             "its first word {sp:08X} is not an initial stack pointer in SRAM \
              ({sram:08X}-{sram_end:08X}): {not_stm32}"
