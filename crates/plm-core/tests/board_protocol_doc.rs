@@ -212,3 +212,40 @@ fn the_usart_vectors_parse_back() {
         });
     }
 }
+
+/// Every link into protocol-notes.md names one of its headings (GitHub's
+/// anchors), so that a renamed section does not leave a dead link here.
+#[test]
+fn the_links_into_the_protocol_notes_resolve() {
+    let notes = include_str!("../../../docs/protocol-notes.md");
+    let mut fenced = false;
+    let mut anchors = Vec::new();
+    for line in notes.lines() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+        }
+        let level = line.bytes().take_while(|&b| b == b'#').count();
+        if !fenced && level > 0 && line[level..].starts_with(' ') {
+            let slug: String = line[level..]
+                .trim()
+                .to_lowercase()
+                .chars()
+                .filter(|c| c.is_alphanumeric() || matches!(c, '_' | '-' | ' '))
+                .map(|c| if c == ' ' { '-' } else { c })
+                .collect();
+            anchors.push(slug);
+        }
+    }
+    let links: Vec<&str> = SPEC
+        .split("protocol-notes.md#")
+        .skip(1)
+        .map(|s| s.split(')').next().unwrap())
+        .collect();
+    assert!(links.len() >= 5, "{links:?}");
+    for link in links {
+        assert!(
+            anchors.iter().any(|a| a == link),
+            "docs/board-protocol.md links to protocol-notes.md#{link}, which is no heading"
+        );
+    }
+}

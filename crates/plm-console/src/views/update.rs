@@ -189,6 +189,7 @@ pub fn UpdateView() -> impl IntoView {
                     {button("update-discard", "Discard", "the boards keep what they run; segments they hold are dropped at the next update", discard)}
                 </div>
             }).map(IntoAny::into_any)}
+            <p class="muted" id="update-protocol">"Needs boards whose firmware and bootloader speak this console's board protocol (docs/board-protocol.md), as the simulated ones do."</p>
             <div class="toolbar">
                 <label>
                     "Image file "
