@@ -1,6 +1,7 @@
-// The console's figures of DESIGN.md "Performance", measured in Chromium
-// against the simulated modem: `cargo xtask bench` runs this after
-// building dist/ (not part of `npm test`: benchmarks are never timed tests).
+// The console's figures of docs/architecture.md "Performance and size",
+// measured in Chromium against the simulated modem: `cargo xtask bench`
+// runs this after building dist/ (not part of `npm test`: benchmarks are
+// never timed tests).
 //
 //   node tests/e2e/bench.mjs          (dist/ must exist: `cargo xtask dist`)
 //
@@ -56,7 +57,10 @@ const STREET_LAMPS = 500;
 const STREET_MEASURE_MS = 20_000;
 /** One frame at 60 fps. */
 const FRAME_MS = 1000 / 60;
-/** The console's size budget, gzipped, everything included (DESIGN.md). */
+/**
+ * The console's size budget, gzipped, everything included (docs/console.md
+ * "Size").
+ */
 const BUDGET = 350 * 1024;
 /** How long the bare wake loop runs. */
 const NOISE_MS = 5_000;

@@ -1,5 +1,6 @@
-//! `cargo xtask bench`: the performance figures of DESIGN.md, measured by
-//! programs that print their own results (never by timed tests).
+//! `cargo xtask bench`: the performance figures of docs/architecture.md
+//! ("Performance and size"), measured by programs that print their own
+//! results (never by timed tests).
 
 use crate::serve;
 use crate::util::{root, run_steps, Cmd, Result, Step};

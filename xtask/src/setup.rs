@@ -8,7 +8,7 @@ use std::fs;
 use std::path::Path;
 use std::time::SystemTime;
 
-/// Trunk 0.22 needs a newer rustc than the workspace's 1.95 (DESIGN.md).
+/// Trunk 0.22 needs a newer rustc than the workspace's 1.95.
 pub const TRUNK_VERSION: &str = "0.21.14";
 const WASM_TARGET: &str = "wasm32-unknown-unknown";
 /// Debian's Chromium, which every browser test drives.
@@ -91,7 +91,7 @@ fn trunk(dry_run: bool) -> Result {
 fn wasm_bindgen_cli(root: &Path, dry_run: bool) -> Result {
     let version = wasm_bindgen_version(root)?;
     // Not `--locked`: its lock file pins a dependency the registry no
-    // longer has (DESIGN.md, tooling facts).
+    // longer has.
     let cmd = Cmd::new("cargo").args(["install", "wasm-bindgen-cli", "--version", &version]);
     let what = format!("wasm-bindgen-cli {version}");
     exact_tool(&what, "wasm-bindgen", &version, &cmd, dry_run)

@@ -1,7 +1,7 @@
 //! `plm sim` serving a street of lamps, end to end: plm-core's
 //! [`Concentrator`] (the one the console and `plm board` drive) talks to
 //! the real binary over RFC 2217 in real time, through both ways in
-//! (DESIGN.md, connection profiles):
+//! (docs/architecture.md, "Connection profiles"):
 //!
 //! - `--board`: a concentrator board's USART (application frames, no
 //!   T_REQ); its firmware carries them over the simulated power line;

@@ -105,7 +105,7 @@ fn current_hash() -> String {
 pub fn App() -> impl IntoView {
     let console = provide_console();
     // A simulated street is there at once, so a newcomer sees lamps on any
-    // machine (DESIGN.md); `?profile=st7580` opens on the simulated modem.
+    // machine; `?profile=st7580` opens on the simulated modem.
     // Else the profile chosen last time (the chip is remembered).
     let chosen = query("profile").or_else(|| crate::storage::load(crate::stores::PROFILE_KEY));
     if let Some(p) = chosen.and_then(|k| Profile::from_key(&k)) {

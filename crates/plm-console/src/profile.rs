@@ -1,5 +1,5 @@
-//! Connection profiles (DESIGN.md): what is at the other end of the
-//! serial port, and so which session drives it. One connection at a
+//! Connection profiles (docs/architecture.md): what is at the other end of
+//! the serial port, and so which session drives it. One connection at a
 //! time, simulated or over WebSerial, for every profile.
 
 use plm_core::link::Dialect;

@@ -5,9 +5,9 @@
 //! words where and what it expected.
 //!
 //! Written here rather than taken from serde_json because the console's
-//! size budget (DESIGN.md: 350 KiB gzipped) does not fit serde_json's
-//! generic code; `tests/json_props.rs` holds this module to serde_json's
-//! output byte for byte.
+//! size budget (350 KiB gzipped, docs/console.md "Size") does not fit
+//! serde_json's generic code; `tests/json_props.rs` holds this module to
+//! serde_json's output byte for byte.
 //!
 //! Numbers: plm-core writes whole numbers ([`Json::Int`]), and the
 //! decimal text of a field read in its unit ([`crate::field::Scale::text`]).

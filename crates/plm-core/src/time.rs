@@ -1,5 +1,5 @@
-//! Virtual time for the sans-IO engines (DESIGN.md: time comes in as an
-//! argument). One tick is one microsecond.
+//! Virtual time for the sans-IO engines (time comes in as an argument,
+//! docs/architecture.md). One tick is one microsecond.
 
 /// A point in time, in microseconds since an arbitrary origin chosen by the
 /// driver (browser `performance.now()`, simulator clock, test).

@@ -1,8 +1,9 @@
-//! Property tests of the ST7580 typed codecs (DESIGN.md "Testing"):
-//! `parse(emit(x)) == x` for every command of UM0932 3.3 and every MIB
-//! object of UM0932 4, the factory defaults of Table 52, and `parse` on
-//! arbitrary bytes (never a panic, the lengths of the manual's tables, and
-//! the same bytes back except the bits the manual marks unused).
+//! Property tests of the ST7580 typed codecs (docs/architecture.md
+//! "Testing"): `parse(emit(x)) == x` for every command of UM0932 3.3 and
+//! every MIB object of UM0932 4, the factory defaults of Table 52, and
+//! `parse` on arbitrary bytes (never a panic, the lengths of the manual's
+//! tables, and the same bytes back except the bits the manual marks
+//! unused).
 
 use plm_core::field::Kind;
 use plm_core::link::{Dialect, Frame, LocalFrame};

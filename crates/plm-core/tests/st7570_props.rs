@@ -1,8 +1,8 @@
-//! Property tests of the ST7570 typed codecs (DESIGN.md "Testing"):
-//! `parse(emit(x)) == x` for every command of Table 15 in both access
-//! layers, for the status message in every row of Table 11 and for every
-//! MIB object's value; and arbitrary bytes never panic a parser, and what
-//! parses emits the same bytes back (nothing is dropped).
+//! Property tests of the ST7570 typed codecs (docs/architecture.md
+//! "Testing"): `parse(emit(x)) == x` for every command of Table 15 in both
+//! access layers, for the status message in every row of Table 11 and for
+//! every MIB object's value; and arbitrary bytes never panic a parser, and
+//! what parses emits the same bytes back (nothing is dropped).
 
 use plm_core::field::Kind;
 use plm_core::link::{Dialect, Frame, Source};

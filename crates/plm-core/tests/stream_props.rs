@@ -1,6 +1,7 @@
-//! Property tests of the stream decoder (DESIGN.md "Testing"): arbitrary
-//! bytes never panic it, nothing is lost or invented, chunking does not
-//! matter, and it resynchronises on every valid frame after garbage.
+//! Property tests of the stream decoder (docs/architecture.md "Testing"):
+//! arbitrary bytes never panic it, nothing is lost or invented, chunking
+//! does not matter, and it resynchronises on every valid frame after
+//! garbage.
 
 use plm_core::decode::{self, Decoder};
 use plm_core::link::{Dialect, Element, Frame, GarbageReason, LocalFrame, Source, StreamDecoder};

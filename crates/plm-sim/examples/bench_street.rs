@@ -1,4 +1,5 @@
-//! `cargo xtask bench`, street part (DESIGN.md, Performance, "Street"):
+//! `cargo xtask bench`, street part (docs/architecture.md,
+//! "Performance and size"):
 //!
 //! 1. Discovering and reading a street of 100 lamps through the
 //!    concentrator board's USART (`StreetDriver::discover`, then

@@ -1,6 +1,6 @@
-//! The simulation's one random number generator (DESIGN.md: deterministic,
-//! one seeded RNG). SplitMix64: tiny, fast, reproducible on every target,
-//! and good enough for losses and noise. Not for keys.
+//! The simulation's one random number generator (the simulation is
+//! deterministic: one seeded RNG). SplitMix64: tiny, fast, reproducible on
+//! every target, and good enough for losses and noise. Not for keys.
 
 /// A seeded pseudo-random generator.
 #[derive(Debug, Clone)]

@@ -1,6 +1,7 @@
 //! A street of simulated controller boards driven by plm-core's
 //! concentrator in virtual time, through both ways in: a concentrator
-//! board's USART and a bare ST7580 (DESIGN.md, connection profiles).
+//! board's USART and a bare ST7580 (docs/architecture.md, "Connection
+//! profiles").
 
 use plm_core::app::hid::{self, Hid, LampState};
 use plm_core::app::service::{Clock, Service};

@@ -2,7 +2,7 @@
 //!
 //! A transport moves bytes and the T_REQ line, and says what time it is;
 //! it knows nothing of frames. The [`crate::session`] drives plm-core's
-//! host link engine over it. Two kinds (DESIGN.md): the simulated modem
+//! host link engine over it. Two kinds: the simulated modem
 //! in the page ([`sim::SimTransport`], the default) and a real modem over
 //! WebSerial (`webserial::WebSerialTransport`, wasm32 only).
 

@@ -14,12 +14,13 @@
 //!   so the order of bytes and RTS changes on the wire is part of the
 //!   protocol.
 //!
-//! T_REQ is on RTS (DESIGN.md), with a selectable polarity. A lost port
-//! (the `disconnect` event of `navigator.serial`, a fatal read error, a
-//! failed write) turns the state into `Disconnected("the serial port was
-//! unplugged: …")` at once: the queue is emptied, the reader is cancelled,
-//! both stream locks are released and the port is closed, so that nothing
-//! stays stuck and the same port can be opened again once it is back.
+//! T_REQ is on RTS (docs/console.md, "Real adapters"), with a selectable
+//! polarity. A lost port (the `disconnect` event of `navigator.serial`, a
+//! fatal read error, a failed write) turns the state into
+//! `Disconnected("the serial port was unplugged: …")` at once: the queue is
+//! emptied, the reader is cancelled, both stream locks are released and the
+//! port is closed, so that nothing stays stuck and the same port can be
+//! opened again once it is back.
 
 use super::{LinkState, Transport};
 use crate::stores::page_now_us;

@@ -1,7 +1,7 @@
 //! Controls every view uses, written once: each is one non-generic
 //! function, so a page of buttons costs one copy of the button's code in
-//! the console's wasm instead of one per button (DESIGN.md, the 350 KiB
-//! budget).
+//! the console's wasm instead of one per button (the 350 KiB budget,
+//! docs/console.md "Size").
 
 use leptos::prelude::*;
 use std::sync::Arc;

@@ -1,6 +1,6 @@
 //! The concentrator: the host's end of a street, sans-IO. One
-//! [`Requester`] over either of the two ways in (DESIGN.md, connection
-//! profiles):
+//! [`Requester`] over either of the two ways in (docs/architecture.md,
+//! "Connection profiles"):
 //!
 //! - [`Carrier::Usart`]: a concentrator **board** on the host's serial
 //!   port; its USART carries application frames (4.6), and its firmware
