@@ -102,15 +102,28 @@ fn a_lamp_that_breaks_a_rule_fails_that_rule_alone() {
     }
 }
 
-/// An unknown rule to break is refused in words.
+/// An unknown rule to break is refused in words, and so is `--break`
+/// without a street's lamps to break it.
 #[test]
 fn an_unknown_rule_to_break_is_refused() {
-    let out = Command::new(env!("CARGO_BIN_EXE_plm"))
-        .args(["sim", "--board", "--break", "everything"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = text(&out.stderr);
+    let refused = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_plm"))
+            .arg("sim")
+            .args(args)
+            .args(["--listen", "127.0.0.1:0"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        text(&out.stderr)
+    };
+    let err = refused(&["--board", "--break", "everything"]);
     assert!(err.contains("not a rule to break"), "{err}");
     assert!(err.contains("discovery-ack"), "{err}");
+    let err = refused(&["--break", "status"]);
+    assert!(err.contains("need a street of lamps"), "{err}");
+    let err = refused(&["--chip", "st7570", "--break", "status"]);
+    assert!(
+        err.contains("--break cannot be used with --chip st7570"),
+        "{err}"
+    );
 }
