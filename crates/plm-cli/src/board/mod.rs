@@ -260,12 +260,7 @@ fn parse_target(s: &str) -> Result<Target, String> {
 }
 
 fn parse_release(s: &str) -> Result<Release, String> {
-    let bad = || format!("'{s}' is not a release: two numbers 0-255 as X.Y, e.g. 1.5");
-    let (x, y) = s.split_once('.').ok_or_else(bad)?;
-    Ok(Release {
-        major: x.parse().map_err(|_| bad())?,
-        minor: y.parse().map_err(|_| bad())?,
-    })
+    Release::parse(s)
 }
 
 /// Runs `plm board`; returns the exit code (errors already printed).

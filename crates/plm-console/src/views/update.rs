@@ -50,13 +50,12 @@ impl Chosen {
     }
 }
 
-/// `x.y` as a release.
-fn release(text: &str) -> Option<Release> {
-    let (x, y) = text.trim().split_once('.')?;
-    Some(Release {
-        major: x.parse().ok()?,
-        minor: y.parse().ok()?,
-    })
+/// `x.y` as a release; `None` for empty text.
+fn release(text: &str) -> Result<Option<Release>, String> {
+    match text.trim() {
+        "" => Ok(None),
+        t => Release::parse(t).map(Some),
+    }
 }
 
 /// The lamps a choice of the target list names.
@@ -70,7 +69,7 @@ fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
         })
     };
     match choice.split_once(':') {
-        Some(("release", r)) => with_release(release(r)),
+        Some(("release", r)) => with_release(Release::parse(r).ok()),
         Some(("lamp", a)) => Address::parse(a).into_iter().collect(),
         _ if choice == "selected" => street.selected.get_untracked(),
         _ => with_release(None),
@@ -104,13 +103,10 @@ pub fn UpdateView() -> impl IntoView {
         });
     };
     let make = move || {
-        let text = make_release.get_untracked();
-        let v = release(&text);
-        if v.is_none() && !text.trim().is_empty() {
-            return message.set(Some(
-                "the release is x.y, two numbers 0-255 (or empty for a plain .bin)".into(),
-            ));
-        }
+        let v = match release(&make_release.get_untracked()) {
+            Ok(v) => v,
+            Err(e) => return message.set(Some(format!("{e} (or empty for a plain .bin)"))),
+        };
         let size = make_size
             .get_untracked()
             .trim()
@@ -140,14 +136,10 @@ pub fn UpdateView() -> impl IntoView {
         let Some(c) = chosen.get_untracked() else {
             return message.set(Some("choose an image file first".into()));
         };
-        let text = stated.get_untracked();
-        let said = release(&text);
-        if said.is_none() && !text.trim().is_empty() {
-            return message.set(Some(format!(
-                "nothing sent: '{}' is not a release: x.y, two numbers 0-255 (or empty)",
-                text.trim()
-            )));
-        }
+        let said = match release(&stated.get_untracked()) {
+            Ok(r) => r,
+            Err(e) => return message.set(Some(format!("nothing sent: {e}"))),
+        };
         let list = targets(street, &choice.get_untracked());
         let r = street.act(|s| s.start_update(c.bytes, said, &list));
         message.set(Some(match r {
