@@ -33,7 +33,7 @@ enum Command {
     Sim(SimArgs),
     /// Talk to street-light controller boards through a concentrator
     /// board or a bare ST7580 on a serial device or an rfc2217:// port:
-    /// discover, status, dimming, firmware update.
+    /// discover, status, dimming, firmware update, conformance.
     Board(board::BoardArgs),
 }
 

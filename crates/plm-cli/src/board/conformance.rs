@@ -235,7 +235,7 @@ fn status_words(s: &Status) -> String {
 pub fn run(d: &mut Driver, node: Address, json: bool) -> Result<u8, Failure> {
     tell!(
         "plm board: checking {node} against the board protocol, version 1 \
-         (docs/board-protocol.md); about 20 s"
+         (docs/board-protocol.md); about 10 s"
     );
     let mut c = Check {
         d,
