@@ -19,6 +19,9 @@
 //! with.
 
 pub mod client;
+pub mod refusal;
+
+pub use refusal::{Malformed, Refusal, Tally};
 
 /// Interpret As Command (RFC 854).
 pub const IAC: u8 = 255;
@@ -78,7 +81,7 @@ pub mod control {
 
 /// A subnegotiation longer than this is cut (its tail is dropped): no
 /// COM-PORT command needs more, and a client cannot make us buffer forever.
-const MAX_SB: usize = 256;
+pub const MAX_SB: usize = 256;
 
 /// What the client sent.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -99,6 +102,8 @@ pub enum Event {
         option: u8,
         data: Vec<u8>,
     },
+    /// Telnet that breaks RFC 854/855, read past as described.
+    Malformed(Malformed),
 }
 
 /// A COM-PORT-OPTION command from the client (RFC 2217). Zero values are
@@ -193,6 +198,8 @@ pub struct Decoder {
     state: State,
     data: Vec<u8>,
     sb: Vec<u8>,
+    /// The open subnegotiation was cut at [`MAX_SB`] bytes.
+    sb_cut: bool,
 }
 
 impl Default for Decoder {
@@ -207,6 +214,7 @@ impl Decoder {
             state: State::Data,
             data: Vec::new(),
             sb: Vec::new(),
+            sb_cut: false,
         }
     }
 
@@ -252,16 +260,17 @@ impl Decoder {
             }
             State::SbOption => {
                 self.sb.clear();
+                self.sb_cut = false;
                 State::Sb(b)
             }
             State::Sb(option) if b == IAC => State::SbIac(option),
             State::Sb(option) => {
-                self.push_sb(b);
+                self.push_sb(option, b, events);
                 State::Sb(option)
             }
             // IAC IAC inside SB is a data 255 (RFC 855).
             State::SbIac(option) if b == IAC => {
-                self.push_sb(b);
+                self.push_sb(option, b, events);
                 State::Sb(option)
             }
             State::SbIac(option) => {
@@ -278,6 +287,8 @@ impl Decoder {
                 if b == SE {
                     State::Data
                 } else {
+                    let broken = Malformed::Unended { option, by: b };
+                    self.emit(events, Event::Malformed(broken));
                     self.command(b, events)
                 }
             }
@@ -294,7 +305,15 @@ impl Decoder {
             WILL | WONT | DO | DONT => State::Negotiation(b),
             SB => State::SbOption,
             // A stray SE ends nothing.
-            SE => State::Data,
+            SE => {
+                self.emit(events, Event::Malformed(Malformed::StraySe));
+                State::Data
+            }
+            // RFC 854's commands are 240-255.
+            0..SE => {
+                self.emit(events, Event::Malformed(Malformed::NotACommand(b)));
+                State::Data
+            }
             _ => {
                 self.emit(events, Event::Command(b));
                 State::Data
@@ -302,9 +321,14 @@ impl Decoder {
         }
     }
 
-    fn push_sb(&mut self, b: u8) {
+    /// One byte of a subnegotiation of `option`; past [`MAX_SB`] it is
+    /// dropped, which is said once.
+    fn push_sb(&mut self, option: u8, b: u8, events: &mut Vec<Event>) {
         if self.sb.len() < MAX_SB {
             self.sb.push(b);
+        } else if !self.sb_cut {
+            self.sb_cut = true;
+            self.emit(events, Event::Malformed(Malformed::TooLong { option }));
         }
     }
 }
@@ -384,6 +408,8 @@ pub struct Server {
     client_signature: Option<Vec<u8>>,
     /// Whether the first modem state was notified.
     notified: bool,
+    /// What was refused on this connection.
+    refusals: Tally,
 }
 
 /// Options we do (and let the client do).
@@ -411,6 +437,7 @@ impl Server {
             him: [Side::default(); 256],
             client_signature: None,
             notified: false,
+            refusals: Tally::default(),
         }
     }
 
@@ -448,6 +475,22 @@ impl Server {
         self.client_signature.as_deref()
     }
 
+    /// What was refused on this connection so far.
+    pub fn refusals(&self) -> &Tally {
+        &self.refusals
+    }
+
+    /// Counts something the driver refused on this connection (a flood
+    /// past its buffers, ...), in the same tally.
+    pub fn refuse(&mut self, r: Refusal) {
+        self.refusals.add(r);
+    }
+
+    /// The first refusal of each kind not yet reported ([`Tally::take_news`]).
+    pub fn take_refusal_news(&mut self) -> Vec<Refusal> {
+        self.refusals.take_news()
+    }
+
     /// Whether the client agreed to COM-PORT-OPTION either way (RFC 2217
     /// names no direction as the one that counts; pyserial asks both).
     pub fn com_port_agreed(&self) -> bool {
@@ -470,6 +513,9 @@ impl Server {
             Event::Data(data) => actions.push(Action::Write(data)),
             Event::Do(option) | Event::Dont(option) => {
                 let on = matches!(event, Event::Do(_));
+                if on && !supported(option) {
+                    self.refusals.add(Refusal::Option { verb: DO, option });
+                }
                 let side = &mut self.us[option as usize];
                 if let Some(verb) = Self::negotiate(side, on, supported(option)) {
                     reply.extend([IAC, verb, option]);
@@ -477,13 +523,21 @@ impl Server {
             }
             Event::Will(option) | Event::Wont(option) => {
                 let on = matches!(event, Event::Will(_));
+                if on && !supported(option) {
+                    self.refusals.add(Refusal::Option { verb: WILL, option });
+                }
                 let side = &mut self.him[option as usize];
                 // The answer to WILL/WONT is DO/DONT.
                 if let Some(verb) = Self::negotiate(side, on, supported(option)) {
                     reply.extend([IAC, verb + 2, option]);
                 }
             }
-            Event::Command(_) | Event::Subnegotiation { .. } => {}
+            Event::Command(_) => {}
+            Event::Subnegotiation { option, data } => {
+                let len = data.len();
+                self.refusals.add(Refusal::Subnegotiation { option, len });
+            }
+            Event::Malformed(m) => self.refusals.add(Refusal::Telnet(m)),
             Event::ComPort(c) => self.com_port(c, reply, actions),
         }
         // Once COM-PORT-OPTION is agreed, the modem lines are notified
@@ -534,14 +588,31 @@ impl Server {
                 if rate != 0 && rate != self.baud && self.rates.contains(&rate) {
                     self.baud = rate;
                     actions.push(Action::SetBaud(rate));
+                } else if rate != 0 && !self.rates.contains(&rate) {
+                    let kept = self.baud;
+                    self.refusals.add(Refusal::Baud { asked: rate, kept });
                 }
                 answer(reply, cmd::SET_BAUDRATE, &self.baud.to_be_bytes())
             }
-            // The UART is 8N1 (UM0932 3.1): every request gets what it is.
-            ComPort::SetDataSize(_) => answer(reply, cmd::SET_DATASIZE, &[8]),
-            ComPort::SetParity(_) => answer(reply, cmd::SET_PARITY, &[1]),
-            ComPort::SetStopSize(_) => answer(reply, cmd::SET_STOPSIZE, &[1]),
+            // The UART is 8N1 (UM0932 3.1): every request gets what it
+            // is; a request for something else (not a query, 0) is refused.
+            ComPort::SetDataSize(asked)
+            | ComPort::SetParity(asked)
+            | ComPort::SetStopSize(asked) => {
+                let (code, what, is) = match c {
+                    ComPort::SetDataSize(_) => (cmd::SET_DATASIZE, "SET-DATASIZE", 8),
+                    ComPort::SetParity(_) => (cmd::SET_PARITY, "SET-PARITY", 1),
+                    _ => (cmd::SET_STOPSIZE, "SET-STOPSIZE", 1),
+                };
+                if asked != 0 && asked != is {
+                    self.refusals.add(Refusal::LineSetting { what, asked });
+                }
+                answer(reply, code, &[is])
+            }
             ComPort::SetControl(value) => {
+                if matches!(value, 2 | 3 | BREAK_ON | 15..) {
+                    self.refusals.add(Refusal::Control(value));
+                }
                 let now = match value {
                     // No flow control either way, whatever is asked: RTS
                     // is T_REQ, not a handshake line.
@@ -599,16 +670,23 @@ impl Server {
                 answer(reply, cmd::SET_MODEMSTATE_MASK, &[mask])
             }
             ComPort::PurgeData(which) => {
-                if which & 1 != 0 {
-                    actions.push(Action::PurgeReceive);
-                }
-                if which & 2 != 0 {
-                    actions.push(Action::PurgeTransmit);
+                if !(1..=3).contains(&which) {
+                    self.refusals.add(Refusal::Purge(which));
+                } else {
+                    if which & 1 != 0 {
+                        actions.push(Action::PurgeReceive);
+                    }
+                    if which & 2 != 0 {
+                        actions.push(Action::PurgeTransmit);
+                    }
                 }
                 answer(reply, cmd::PURGE_DATA, &[which])
             }
             // RFC 2217 defines no answer to what it does not define.
-            ComPort::Unknown { .. } => {}
+            ComPort::Unknown { code, data } => {
+                let len = data.len();
+                self.refusals.add(Refusal::ComPort { code, len });
+            }
         }
     }
 }
@@ -714,9 +792,104 @@ mod tests {
             ]),
             [
                 Event::ComPort(ComPort::SetControl(11)),
+                Event::Malformed(Malformed::Unended {
+                    option: COM_PORT_OPTION,
+                    by: DO
+                }),
                 Event::Do(SGA),
                 Event::Data(vec![5]),
             ]
+        );
+    }
+
+    #[test]
+    fn malformed_telnet_is_named_and_read_past() {
+        let mut d = Decoder::new();
+        // IAC then a byte below 240, a stray SE, an SB ended by IAC DO.
+        let got = d.feed(&[1, IAC, 7, 2, IAC, SE, IAC, SB, 24, 9, IAC, DO, SGA, 3]);
+        assert_eq!(
+            got,
+            [
+                Event::Data(vec![1]),
+                Event::Malformed(Malformed::NotACommand(7)),
+                Event::Data(vec![2]),
+                Event::Malformed(Malformed::StraySe),
+                Event::Subnegotiation {
+                    option: 24,
+                    data: vec![9]
+                },
+                Event::Malformed(Malformed::Unended { option: 24, by: DO }),
+                Event::Do(SGA),
+                Event::Data(vec![3]),
+            ]
+        );
+        // An endless SB is cut once, said once, and ends at IAC SE.
+        let mut long = vec![IAC, SB, COM_PORT_OPTION];
+        long.extend([0x41; 3 * MAX_SB]);
+        let mut got = d.feed(&long);
+        got.extend(d.feed(&[0x41; 1000]));
+        assert_eq!(
+            got,
+            [Event::Malformed(Malformed::TooLong {
+                option: COM_PORT_OPTION
+            })]
+        );
+        let got = d.feed(&[IAC, SE, 5]);
+        assert!(
+            matches!(&got[..], [Event::ComPort(ComPort::Unknown { code: 0x41, data }), Event::Data(x)]
+                if data.len() == MAX_SB - 1 && x == &[5]),
+            "{got:?}"
+        );
+    }
+
+    #[test]
+    fn the_server_counts_what_it_refuses() {
+        let mut s = server();
+        let mut bytes = vec![IAC, DO, 24, IAC, 7];
+        bytes.extend(sb(cmd::SET_BAUDRATE, &u32::MAX.to_be_bytes()));
+        bytes.extend(sb(cmd::SET_BAUDRATE, &0u32.to_be_bytes()));
+        bytes.extend(sb(cmd::SET_BAUDRATE, &[1, 2]));
+        bytes.extend(sb(cmd::SET_DATASIZE, &[7]));
+        bytes.extend(sb(cmd::SET_DATASIZE, &[8]));
+        bytes.extend(sb(cmd::SET_CONTROL, &[control::BREAK_ON]));
+        bytes.extend(sb(cmd::SET_CONTROL, &[control::RTS_ON]));
+        bytes.extend(sb(cmd::PURGE_DATA, &[4]));
+        let (_, actions) = send(&mut s, &bytes);
+        // RTS is done; PURGE-DATA 4 purges nothing.
+        assert_eq!(actions, [Action::SetRts(true)]);
+        let news = s.take_refusal_news();
+        assert_eq!(
+            news,
+            [
+                Refusal::Option {
+                    verb: DO,
+                    option: 24
+                },
+                Refusal::Telnet(Malformed::NotACommand(7)),
+                Refusal::Baud {
+                    asked: u32::MAX,
+                    kept: 57600
+                },
+                Refusal::ComPort {
+                    code: cmd::SET_BAUDRATE,
+                    len: 2
+                },
+                Refusal::LineSetting {
+                    what: "SET-DATASIZE",
+                    asked: 7
+                },
+                Refusal::Control(control::BREAK_ON),
+                Refusal::Purge(4),
+            ]
+        );
+        // A query (baud 0, data size 0) and what is served are no refusal.
+        let (_, _) = send(&mut s, &sb(cmd::SET_BAUDRATE, &[0, 0, 0, 0]));
+        assert!(s.take_refusal_news().is_empty());
+        assert_eq!(
+            s.refusals().summary().unwrap(),
+            "1 malformed Telnet sequence, 1 option not served, 1 unknown RFC 2217 command, \
+             1 baud rate refused, 1 line setting other than 8N1, 1 SET-CONTROL value refused, \
+             1 unknown PURGE-DATA value"
         );
     }
 

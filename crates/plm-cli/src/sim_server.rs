@@ -31,13 +31,18 @@
 //! nodes not served echo, by default with node 0's MIB 00h/01h
 //! (`Peers::EchoFollowing`), with `--peers factory` at the factory MIB.
 //!
-//! When the client goes, T_REQ and DTR are released and the simulation
-//! goes on. DTR is wired to RESETN, as on many USB-UART boards: a client
+//! When the client goes, what it sent and the modem has not yet read is
+//! discarded, as a purge of a real port's buffers would ([`client::purge`]),
+//! T_REQ and DTR are released and the simulation goes on. What a client
+//! can make the server hold is bounded ([`client`]), and what it refuses
+//! it says on stderr in words ([`crate::rfc2217::Refusal`]), the first of
+//! each kind at once, all of them summed up when the client goes. DTR is wired to RESETN, as on many USB-UART boards: a client
 //! that asserts it holds the modem off (a DTR pulse resets it, factory
 //! MIB and BIO_ResetIndication); a client that never touches DTR finds the
 //! modem running (the line starts released).
 
 pub mod alarms;
+pub mod client;
 pub mod event_loop;
 
 pub use event_loop::{Served, Stopper, RATES};

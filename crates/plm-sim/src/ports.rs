@@ -4,7 +4,7 @@
 //! ([`crate::Sim`]) and the ST7570 S-FSK network
 //! ([`crate::st7570::net::Network`]).
 
-use plm_core::time::Instant;
+use plm_core::time::{Duration, Instant};
 
 /// A simulation whose nodes 0..[`Ports::served`] have their host outside.
 pub trait Ports {
@@ -23,6 +23,15 @@ pub trait Ports {
     /// Sets served node `node`'s UART baud rate both ways and at the
     /// modem (its BR pins strapped to match).
     fn set_baud_of(&mut self, node: usize, baud: u32);
+    /// How long until the bytes served node `node`'s host wrote so far
+    /// have all reached the modem (0 when none are on the way).
+    fn backlog_to_modem(&self, node: usize) -> Duration;
+    /// Purges the transmit side of served node `node`'s host, as its
+    /// serial driver does on a purge (RFC 2217 PURGE-DATA, or the host
+    /// gone): the bytes it wrote that the modem has not yet received are
+    /// lost, and a T_REQ change waiting behind them takes effect now.
+    /// The modem runs on (nothing is reset).
+    fn purge_to_modem(&mut self, node: usize);
     /// Bytes that reached served node `node`'s host by now, with their
     /// arrival times.
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)>;
@@ -51,6 +60,12 @@ impl Ports for crate::Sim {
     }
     fn set_baud_of(&mut self, node: usize, baud: u32) {
         crate::Sim::set_baud_of(self, node, baud)
+    }
+    fn backlog_to_modem(&self, node: usize) -> Duration {
+        crate::Sim::backlog_to_modem(self, node)
+    }
+    fn purge_to_modem(&mut self, node: usize) {
+        crate::Sim::purge_to_modem(self, node)
     }
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         crate::Sim::host_read_of(self, node)

@@ -708,6 +708,48 @@ impl Sim {
         self.schedule(at, Ev::Treq { node, asserted });
     }
 
+    /// How long until the bytes served node `node`'s host wrote so far
+    /// have all reached its modem (or the concentrator board's USART).
+    pub fn backlog_to_modem(&self, node: usize) -> Duration {
+        let drained = match (self.attach, node) {
+            (Attach::Board, 0) => self.usart_down.drained_at(self.now),
+            _ => self
+                .nodes
+                .get(node)
+                .map_or(self.now, |n| n.down.drained_at(self.now)),
+        };
+        drained - self.now
+    }
+
+    /// Purges the transmit side of served node `node`'s host (its serial
+    /// driver dropping its buffer): the bytes it wrote that have not yet
+    /// reached the modem (or the board's USART) are lost, and a T_REQ
+    /// change waiting behind them takes effect now, at the level the host
+    /// set last. The modem runs on.
+    pub fn purge_to_modem(&mut self, node: usize) {
+        if node >= self.served() {
+            return;
+        }
+        let now = self.now;
+        let board = self.attach == Attach::Board && node == 0;
+        self.wire(node, Dir::HostToModem).purge(now);
+        let mut treq_waited = false;
+        self.queue.retain(|s| match s.0.ev {
+            // A board's own firmware writes to node 0's modem: kept.
+            Ev::ToModem { node: n, .. } => board || n != node,
+            Ev::ToUsart { .. } => !board,
+            Ev::Treq { node: n, .. } if n == node => {
+                treq_waited = true;
+                false
+            }
+            _ => true,
+        });
+        if treq_waited {
+            let asserted = self.treq[node];
+            self.schedule(now, Ev::Treq { node, asserted });
+        }
+    }
+
     /// Bytes that reached node 0's host by now, with their arrival times.
     pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
         self.host_read_of(0)

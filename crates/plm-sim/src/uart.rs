@@ -96,6 +96,16 @@ impl Wire {
         self.idle_at.max(now)
     }
 
+    /// A purge of the transmitter at `now` (a host's serial driver
+    /// dropping its transmit buffer): the line is idle from `now`, and the
+    /// caller drops the arrivals after `now` that [`Wire::write`] gave it.
+    pub fn purge(&mut self, now: Instant) {
+        if self.idle_at > now {
+            self.idle_at = now;
+            self.run = (now, 0);
+        }
+    }
+
     /// Writes `bytes` at `now`; returns each byte that arrives, with its
     /// arrival time (the end of its stop bit).
     pub fn write(&mut self, now: Instant, bytes: &[u8], rng: &mut Rng) -> Vec<(Instant, u8)> {
@@ -158,6 +168,21 @@ mod tests {
         assert_eq!(w.drained_at(0), 4167);
         // Idle again: a new run.
         assert_eq!(w.write(10_000, &[5], &mut rng), vec![(11_042, 5)]);
+    }
+
+    #[test]
+    fn a_purged_wire_is_idle_at_once() {
+        let mut w = Wire::new(9_600);
+        let mut rng = Rng::new(1);
+        w.write(0, &[0; 100], &mut rng);
+        assert_eq!(w.drained_at(2_000), wire_time(100, 9_600));
+        w.purge(2_000);
+        assert_eq!(w.drained_at(2_000), 2_000);
+        // The next byte starts a run of its own at once.
+        assert_eq!(w.write(2_000, &[7], &mut rng), vec![(3_042, 7)]);
+        // An idle wire is left as it is.
+        w.purge(1_000_000);
+        assert_eq!(w.drained_at(0), 3_042);
     }
 
     #[test]

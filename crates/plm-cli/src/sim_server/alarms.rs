@@ -4,7 +4,7 @@
 //! served node sees CMD_AlarmIndication come in. A Server that is not
 //! synchronized has its request refused, and nothing is heard.
 
-use plm_core::time::Instant;
+use plm_core::time::{Duration, Instant};
 use plm_sim::st7570::net::Network;
 use plm_sim::Ports;
 
@@ -68,6 +68,14 @@ impl Ports for Alarming {
 
     fn set_baud_of(&mut self, node: usize, baud: u32) {
         self.net.set_baud_of(node, baud);
+    }
+
+    fn backlog_to_modem(&self, node: usize) -> Duration {
+        self.net.backlog_to_modem(node)
+    }
+
+    fn purge_to_modem(&mut self, node: usize) {
+        self.net.purge_to_modem(node);
     }
 
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {

@@ -8,13 +8,14 @@
 //! point 8), and nothing runs while nothing happens.
 //!
 //! Each listener has a thread blocked in `accept`, each client a thread
-//! blocked in `read`; they pass what they get through one channel, whose
+//! blocked in `read` and one in `write` ([`super::client`]); they pass
+//! what they get through one channel, whose
 //! timed wait (unlike a socket's read timeout, rounded to the kernel's
 //! scheduler tick) ends within some tens of microseconds of the deadline.
 
-use crate::rfc2217::{self, Action};
+use super::client::{self, Chunk, Client, Purge};
 use plm_sim::Ports;
-use std::io::{ErrorKind, Read, Write};
+use std::io::Write;
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::time::{Duration, Instant};
@@ -24,7 +25,7 @@ use std::time::{Duration, Instant};
 pub const RATES: &[u32] = &plm_core::link::BAUD_RATES;
 
 /// What wakes the loop.
-enum Wake {
+pub(super) enum Wake {
     /// A client connected to node `node`'s port.
     Accepted {
         node: usize,
@@ -32,7 +33,7 @@ enum Wake {
         peer: SocketAddr,
     },
     /// Bytes from connection `conn`.
-    Data { conn: u64, bytes: Vec<u8> },
+    Data { conn: u64, chunk: Chunk },
     /// Connection `conn` closed or failed.
     Closed { conn: u64, why: String },
     /// Ctrl-C, SIGTERM or [`Stopper::stop`].
@@ -122,6 +123,7 @@ impl Served {
             self.forward();
         }
         for c in self.clients.into_iter().flatten() {
+            c.close();
             let _ = c.stream.shutdown(Shutdown::Both);
             println!("plm sim: client {} disconnected (stopping)", c.peer);
         }
@@ -144,15 +146,19 @@ impl Served {
     fn handle(&mut self, wake: Wake) {
         match wake {
             Wake::Accepted { node, stream, peer } => self.accepted(node, stream, peer),
-            Wake::Data { conn, bytes } => {
+            Wake::Data { conn, chunk } => {
                 let Some(node) = self.node_of(conn) else {
-                    return; // a client already dropped
+                    return; // a client already gone: its bytes with it
                 };
                 // The bytes arrived now: bring the modems up to now first.
                 self.advance();
-                let c = self.clients[node].as_mut().expect("node_of");
-                if let Err(e) = c.receive(self.sim.as_mut(), node, &bytes) {
-                    self.drop_client(node, &e.to_string());
+                let Some(c) = self.clients[node].as_mut() else {
+                    return;
+                };
+                let done = c.receive(self.sim.as_mut(), node, &chunk.bytes);
+                say_refusals(c);
+                if let Err(why) = done {
+                    self.drop_client(node, &why);
                 }
             }
             Wake::Closed { conn, why } => {
@@ -180,14 +186,8 @@ impl Served {
         self.conns += 1;
         let conn = self.conns;
         let signature = &self.signatures[node];
-        let opened =
-            Client::open(stream, peer, conn, self.sim.baud_of(node), signature).and_then(|c| {
-                let reader = c.stream.try_clone()?;
-                let tx = self.sender.clone();
-                std::thread::spawn(move || read(conn, reader, tx));
-                Ok(c)
-            });
-        match opened {
+        let baud = self.sim.baud_of(node);
+        match Client::open(stream, peer, conn, baud, signature, &self.sender) {
             Ok(c) => {
                 if self.clients.len() > 1 {
                     println!("plm sim: client {peer} connected to node {node}");
@@ -213,22 +213,44 @@ impl Served {
             let Some(c) = self.clients[node].as_mut() else {
                 continue;
             };
-            if let Err(e) = c.send(&out) {
-                self.drop_client(node, &e.to_string());
+            let sent = c.send(&out);
+            say_refusals(c);
+            if let Err(why) = sent {
+                self.drop_client(node, &why);
             }
         }
     }
 
+    /// The client of `node` goes: its port is purged both ways (what it
+    /// sent and the modem has not read is lost, as on a real port), T_REQ
+    /// and DTR are released (pulled up); the modem runs on.
     fn drop_client(&mut self, node: usize, why: &str) {
-        let Some(c) = self.clients[node].take() else {
+        let Some(mut c) = self.clients[node].take() else {
             return;
         };
+        c.close();
         let _ = c.stream.shutdown(Shutdown::Both);
         println!("plm sim: client {} disconnected ({why})", c.peer);
+        say_refusals(&mut c);
+        if let Some(all) = c.refusal_summary() {
+            eprintln!("plm sim: client {} refused, in all: {all}", c.peer);
+        }
         self.advance();
-        // The host is gone: T_REQ and DTR are released (pulled up).
+        client::purge(self.sim.as_mut(), node, &mut c.held, Purge::BOTH);
         self.sim.set_treq_of(node, false);
         self.sim.set_resetn_of(node, false);
+    }
+}
+
+/// Says the first refusal of each kind a client earned since last time,
+/// one line each (the rest are counted, and summed up when it goes).
+fn say_refusals(c: &mut Client) {
+    for r in c.refusal_news() {
+        eprintln!(
+            "plm sim: client {}: refused {r} (more of the kind are counted and summed up when \
+             it goes)",
+            c.peer
+        );
     }
 }
 
@@ -239,6 +261,8 @@ fn accept(node: usize, listener: TcpListener, tx: Sender<Wake>) {
             Ok((peer, stream)) => tx.send(Wake::Accepted { node, stream, peer }),
             Err(e) => {
                 eprintln!("plm sim: accept failed: {e}");
+                // Out of descriptors, say: a moment before the next try.
+                std::thread::sleep(Duration::from_millis(10));
                 Ok(())
             }
         };
@@ -248,108 +272,9 @@ fn accept(node: usize, listener: TcpListener, tx: Sender<Wake>) {
     }
 }
 
-/// A client's thread: its bytes to the loop as they come.
-fn read(conn: u64, mut stream: TcpStream, tx: Sender<Wake>) {
-    let mut buf = [0u8; 4096];
-    let why = loop {
-        match stream.read(&mut buf) {
-            Ok(0) => break "closed by the client".to_string(),
-            Ok(n) => {
-                let bytes = buf[..n].to_vec();
-                if tx.send(Wake::Data { conn, bytes }).is_err() {
-                    return;
-                }
-            }
-            Err(e) if e.kind() == ErrorKind::Interrupted => {}
-            Err(e) => break e.to_string(),
-        }
-    };
-    let _ = tx.send(Wake::Closed { conn, why });
-}
-
 /// A second client while one is connected: told and closed.
 fn refuse(mut stream: TcpStream, peer: SocketAddr) {
     println!("plm sim: refused {peer}: a client is already connected");
     let _ = stream.write_all(b"plm sim: busy: the simulated modem has a client already\r\n");
     let _ = stream.shutdown(Shutdown::Both);
-}
-
-/// A connected client.
-struct Client {
-    stream: TcpStream,
-    peer: SocketAddr,
-    conn: u64,
-    telnet: rfc2217::Server,
-    /// Modem bytes held while the client has suspended the flow
-    /// (RFC 2217 FLOWCONTROL-SUSPEND).
-    held: Vec<u8>,
-}
-
-impl Client {
-    fn open(
-        stream: TcpStream,
-        peer: SocketAddr,
-        conn: u64,
-        baud: u32,
-        signature: &str,
-    ) -> std::io::Result<Client> {
-        stream.set_nonblocking(false)?;
-        // Bytes go out as they come: Nagle's delay would eat T_ACK (40 ms).
-        stream.set_nodelay(true)?;
-        stream.set_write_timeout(Some(Duration::from_secs(5)))?;
-        let mut c = Client {
-            stream,
-            peer,
-            conn,
-            telnet: rfc2217::Server::new(signature, baud, RATES),
-            held: Vec::new(),
-        };
-        let greeting = c.telnet.greeting();
-        c.stream.write_all(&greeting)?;
-        Ok(c)
-    }
-
-    /// Sends modem bytes to the client, IAC doubled (RFC 2217 "Data
-    /// transfer": the data stream is Telnet, RFC 854).
-    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-        self.held.extend_from_slice(bytes);
-        if self.telnet.suspended() || self.held.is_empty() {
-            return Ok(());
-        }
-        let data = rfc2217::escape(&self.held);
-        self.held.clear();
-        self.stream.write_all(&data)
-    }
-
-    /// Carries out what the client sent:
-    ///
-    /// | client (RFC 2217)                    | simulated modem `node`     |
-    /// |--------------------------------------|----------------------------|
-    /// | data                                 | host UART TX -> modem RX   |
-    /// | SET-BAUDRATE 9600/19200/38400/57600  | BR pins (`Ports::set_baud_of`) |
-    /// | SET-CONTROL RTS ON / OFF             | T_REQ asserted / released  |
-    /// | SET-CONTROL DTR ON / OFF             | RESETN held low / released |
-    fn receive(&mut self, sim: &mut dyn Ports, node: usize, bytes: &[u8]) -> std::io::Result<()> {
-        let mut reply = Vec::new();
-        for action in self.telnet.receive(bytes, &mut reply) {
-            match action {
-                Action::Write(data) => sim.write_to(node, &data),
-                Action::SetBaud(baud) => sim.set_baud_of(node, baud),
-                Action::SetRts(on) => sim.set_treq_of(node, on),
-                // DTR wired to RESETN, as on many USB-UART boards: asserted
-                // holds the modem in reset, released boots it.
-                Action::SetDtr(on) => sim.set_resetn_of(node, on),
-                Action::PurgeReceive => {
-                    self.held.clear();
-                    sim.host_read_of(node);
-                }
-                // Client data goes to the UART at once: nothing is held.
-                Action::PurgeTransmit => {}
-                Action::Suspend(_) => {}
-            }
-        }
-        self.stream.write_all(&reply)?;
-        // Resuming sends what was held.
-        self.send(&[])
-    }
 }

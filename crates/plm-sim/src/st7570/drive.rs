@@ -100,6 +100,25 @@ impl ModemDriver {
         self.treq.push_back((at, asserted));
     }
 
+    /// How long until the bytes the outside host wrote so far have all
+    /// reached the modem.
+    pub fn backlog_to_modem(&self) -> Duration {
+        self.to_modem.drained_at(self.now) - self.now
+    }
+
+    /// Purges the outside host's transmit side (its serial driver dropping
+    /// its buffer): the bytes it wrote that have not yet reached the modem
+    /// are lost, and a T_REQ change waiting behind them takes effect now,
+    /// at the level the host set last. The modem runs on.
+    pub fn purge_to_modem(&mut self) {
+        self.to_modem.purge(self.now);
+        self.at_modem.clear();
+        if let Some(&(_, asserted)) = self.treq.back() {
+            self.treq.clear();
+            self.treq.push_back((self.now, asserted));
+        }
+    }
+
     /// The modem's bytes that reached the outside host by now.
     pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
         self.outside

@@ -567,6 +567,25 @@ impl Ports for Network {
         }
     }
 
+    fn backlog_to_modem(&self, node: usize) -> Duration {
+        // The driver's clock lags the network's until it is flushed.
+        self.nodes
+            .get(node)
+            .filter(|n| n.driver.is_outside())
+            .map_or(0, |n| {
+                let left = n.driver.backlog_to_modem() + n.driver.now();
+                left.saturating_sub(self.now)
+            })
+    }
+
+    fn purge_to_modem(&mut self, node: usize) {
+        let now = self.now;
+        if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
+            n.driver.flush(now);
+            n.driver.purge_to_modem();
+        }
+    }
+
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         self.nodes
             .get_mut(node)
