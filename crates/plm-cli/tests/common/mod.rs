@@ -43,16 +43,31 @@ pub struct Server {
 impl Server {
     /// Starts `plm sim <args>` and waits for the address it prints.
     pub fn start(args: &[&str]) -> Server {
+        Server::spawn(args, false)
+    }
+
+    /// As [`Server::start`], its standard error read too, line by line
+    /// among the others (in no set order with them).
+    pub fn start_with_stderr(args: &[&str]) -> Server {
+        Server::spawn(args, true)
+    }
+
+    fn spawn(args: &[&str], stderr: bool) -> Server {
         let mut child = Command::new(env!("CARGO_BIN_EXE_plm"))
             .arg("sim")
             .args(args)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
+            .stderr(if stderr {
+                Stdio::piped()
+            } else {
+                Stdio::inherit()
+            })
             .spawn()
             .expect("plm runs");
         let (tx, lines) = channel();
         let stdout = child.stdout.take().unwrap();
+        let tx_err = tx.clone();
         std::thread::spawn(move || {
             for line in BufReader::new(stdout).lines() {
                 let Ok(line) = line else { break };
@@ -61,6 +76,16 @@ impl Server {
                 }
             }
         });
+        if let Some(err) = child.stderr.take() {
+            std::thread::spawn(move || {
+                for line in BufReader::new(err).lines() {
+                    let Ok(line) = line else { break };
+                    if tx_err.send(line).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
         let mut server = Server {
             child,
             lines,
@@ -114,6 +139,20 @@ impl Server {
     /// The lines printed so far and not yet looked at (no waiting).
     pub fn lines_so_far(&mut self) -> Vec<String> {
         self.lines.try_iter().collect()
+    }
+
+    /// Its process id.
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Whether it is still running (`Err`: how it ended).
+    pub fn running(&mut self) -> Result<(), String> {
+        match self.child.try_wait() {
+            Ok(None) => Ok(()),
+            Ok(Some(status)) => Err(format!("plm sim exited with {status}")),
+            Err(e) => Err(e.to_string()),
+        }
     }
 
     /// Stops it as Ctrl-C would; it must exit 0.
