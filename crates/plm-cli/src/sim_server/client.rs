@@ -32,8 +32,10 @@ pub const TX_BUFFER: usize = 4096;
 /// lost.
 pub const HELD: usize = 4096;
 
-/// Bytes read from a client and not yet handled by the loop.
-pub const IN_FLIGHT: usize = 64 * 1024;
+/// Bytes read from a client and not yet handled by the loop (two reads):
+/// what another client sends never waits behind more than this of one
+/// client's.
+pub const IN_FLIGHT: usize = 8 * 1024;
 
 /// Bytes waiting to be written to a client: past this it reads nothing,
 /// and it is dropped.
