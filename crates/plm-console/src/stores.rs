@@ -416,13 +416,11 @@ impl Console {
         self.with_active(|t, _| t.map(|t| t.set_dtr(true)));
         self.refresh();
         let c = *self;
-        set_timeout(
-            move || {
-                c.with_active(|t, _| t.map(|t| t.set_dtr(false)));
-                c.refresh();
-            },
-            std::time::Duration::from_millis(RESETN_PULSE_MS),
-        );
+        gloo_timers::callback::Timeout::new(RESETN_PULSE_MS as u32, move || {
+            c.with_active(|t, _| t.map(|t| t.set_dtr(false)));
+            c.refresh();
+        })
+        .forget();
     }
 
     /// Changes the profile and connects its simulated world.

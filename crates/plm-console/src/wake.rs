@@ -23,6 +23,7 @@
 #[cfg(target_arch = "wasm32")]
 mod page {
     use crate::stores::page_now_us;
+    use gloo_timers::callback::Timeout;
     use std::cell::RefCell;
     use std::rc::Rc;
     use wasm_bindgen::closure::Closure;
@@ -35,9 +36,9 @@ mod page {
         due: f64,
         /// A message is on its way.
         posted: bool,
-        timer: Option<i32>,
+        /// The timer for a later deadline (dropped: cancelled).
+        timer: Option<Timeout>,
         window: Window,
-        on_timer: Closure<dyn FnMut()>,
         _on_message: Closure<dyn FnMut()>,
     }
 
@@ -61,10 +62,6 @@ mod page {
         });
         let _ =
             window.add_event_listener_with_callback("message", on_message.as_ref().unchecked_ref());
-        let on_timer = Closure::<dyn FnMut()>::new(|| {
-            with(|w| w.timer = None);
-            arm();
-        });
         WAKER.with(|w| {
             *w.borrow_mut() = Some(Waker {
                 run,
@@ -72,7 +69,6 @@ mod page {
                 posted: false,
                 timer: None,
                 window,
-                on_timer,
                 _on_message: on_message,
             })
         });
@@ -100,13 +96,10 @@ mod page {
             if ms < 1.0 {
                 w.post();
             } else if ms.is_finite() && w.timer.is_none() {
-                w.timer = w
-                    .window
-                    .set_timeout_with_callback_and_timeout_and_arguments_0(
-                        w.on_timer.as_ref().unchecked_ref(),
-                        ms as i32,
-                    )
-                    .ok();
+                w.timer = Some(Timeout::new(ms as u32, || {
+                    with(|w| w.timer = None);
+                    arm();
+                }));
             }
             None
         });
@@ -121,9 +114,7 @@ mod page {
                 return;
             }
             w.due = page_us;
-            if let Some(t) = w.timer.take() {
-                w.window.clear_timeout_with_handle(t);
-            }
+            w.timer = None;
             w.post();
         });
     }
