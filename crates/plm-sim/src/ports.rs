@@ -32,6 +32,10 @@ pub trait Ports {
     /// lost, and a T_REQ change waiting behind them takes effect now.
     /// The modem runs on (nothing is reset).
     fn purge_to_modem(&mut self, node: usize);
+    /// Purges the receive side of served node `node`'s host: the bytes
+    /// that reached it and are not yet read, and those on their way to it
+    /// (they are not heard; the modem's UART still takes their time).
+    fn purge_to_host(&mut self, node: usize);
     /// Bytes that reached served node `node`'s host by now, with their
     /// arrival times.
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)>;
@@ -66,6 +70,9 @@ impl Ports for crate::Sim {
     }
     fn purge_to_modem(&mut self, node: usize) {
         crate::Sim::purge_to_modem(self, node)
+    }
+    fn purge_to_host(&mut self, node: usize) {
+        crate::Sim::purge_to_host(self, node)
     }
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         crate::Sim::host_read_of(self, node)

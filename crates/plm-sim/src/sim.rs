@@ -750,6 +750,22 @@ impl Sim {
         }
     }
 
+    /// Purges the receive side of served node `node`'s host: the bytes
+    /// that reached it and are not yet read, and those on their way to it
+    /// (not heard; the modem's UART still takes their time).
+    pub fn purge_to_host(&mut self, node: usize) {
+        if node >= self.served() {
+            return;
+        }
+        let board = self.attach == Attach::Board && node == 0;
+        self.queue.retain(|s| match s.0.ev {
+            Ev::ToHost { node: n, .. } => board || n != node,
+            Ev::FromUsart { .. } => !board,
+            _ => true,
+        });
+        self.host_rx[node].clear();
+    }
+
     /// Bytes that reached node 0's host by now, with their arrival times.
     pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
         self.host_read_of(0)

@@ -39,6 +39,24 @@ fn t_req_waits_for_the_noise_until_purged(p: &mut dyn Ports) {
     assert!(read(p).is_empty());
 }
 
+/// The status message on its way to the host is not heard after a purge
+/// of the host's receive side.
+fn what_is_on_the_way_to_the_host_is_purged(p: &mut dyn Ports) {
+    p.advance_to(200 * MS);
+    read(p);
+    p.set_treq_of(0, true);
+    p.advance_to(200 * MS + 100);
+    p.purge_to_host(0);
+    p.advance_to(300 * MS);
+    assert!(read(p).is_empty(), "heard after the purge");
+}
+
+#[test]
+fn a_hosts_receive_purge_drops_what_is_on_its_way() {
+    what_is_on_the_way_to_the_host_is_purged(&mut Sim::new(SimConfig::default()));
+    what_is_on_the_way_to_the_host_is_purged(&mut Network::new(NetConfig::served_line(1, 1, 1)));
+}
+
 #[test]
 fn an_st7580_hosts_purge_drops_its_bytes_in_flight() {
     let mut sim = Sim::new(SimConfig::default());

@@ -78,6 +78,10 @@ impl Ports for Alarming {
         self.net.purge_to_modem(node);
     }
 
+    fn purge_to_host(&mut self, node: usize) {
+        self.net.purge_to_host(node);
+    }
+
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         self.net.host_read_of(node)
     }

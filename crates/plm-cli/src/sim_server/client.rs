@@ -62,15 +62,16 @@ impl Purge {
 /// what the client sent and the modem has not yet read (in the simulated
 /// UART, [`Ports::purge_to_modem`], a T_REQ change waiting behind it
 /// coming now); `receive`, what the modem sent and the client has not
-/// yet had (`held` while the flow is suspended, and what reached the host
-/// side of the UART). The modem runs on: nothing is reset.
+/// yet had (`held` while the flow is suspended, what reached the host
+/// side of the UART and what is on its way there,
+/// [`Ports::purge_to_host`]). The modem runs on: nothing is reset.
 pub fn purge(sim: &mut dyn Ports, node: usize, held: &mut Vec<u8>, which: Purge) {
     if which.transmit {
         sim.purge_to_modem(node);
     }
     if which.receive {
         held.clear();
-        sim.host_read_of(node);
+        sim.purge_to_host(node);
     }
 }
 

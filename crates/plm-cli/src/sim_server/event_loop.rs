@@ -236,8 +236,11 @@ impl Served {
             eprintln!("plm sim: client {} refused, in all: {all}", c.peer);
         }
         self.advance();
-        client::purge(self.sim.as_mut(), node, &mut c.held, Purge::BOTH);
+        // T_REQ released before the purge, which applies the last level
+        // at once: the departed client's last RTS ON never reaches the
+        // modem as a pulse (whose status message nobody would read).
         self.sim.set_treq_of(node, false);
+        client::purge(self.sim.as_mut(), node, &mut c.held, Purge::BOTH);
         self.sim.set_resetn_of(node, false);
     }
 }

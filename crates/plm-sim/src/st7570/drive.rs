@@ -119,6 +119,15 @@ impl ModemDriver {
         }
     }
 
+    /// Purges the outside host's receive side: the modem's bytes that
+    /// reached it and are not yet read, and those on their way to it.
+    pub fn purge_to_host(&mut self) {
+        self.at_host.clear();
+        if let Some(out) = self.outside.as_mut() {
+            out.clear();
+        }
+    }
+
     /// The modem's bytes that reached the outside host by now.
     pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
         self.outside

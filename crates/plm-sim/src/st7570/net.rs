@@ -586,6 +586,14 @@ impl Ports for Network {
         }
     }
 
+    fn purge_to_host(&mut self, node: usize) {
+        let now = self.now;
+        if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
+            n.driver.flush(now);
+            n.driver.purge_to_host();
+        }
+    }
+
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         self.nodes
             .get_mut(node)
