@@ -147,11 +147,17 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
                     let at = f64::from(wrap.scroll_top()).max(0.0) as u32;
                     let bottom = at as i32 + wrap.client_height() + ROW_PX as i32 / 2
                         >= wrap.scroll_height();
-                    if top.get_untracked() != at {
+                    let was = top.get_untracked();
+                    if was != at {
                         top.set(at);
                     }
-                    if follow.get_untracked() != bottom {
-                        follow.set(bottom);
+                    // Only a scroll up leaves the newest rows: rows coming in
+                    // grow the table under a scroll position that the next
+                    // frame moves to the bottom, and a scroll event between
+                    // the two is not the user's.
+                    let follows = bottom || (follow.get_untracked() && at >= was);
+                    if follow.get_untracked() != follows {
+                        follow.set(follows);
                     }
                 })
             >
