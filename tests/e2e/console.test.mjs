@@ -8,7 +8,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import path from 'node:path';
-import { artifacts, launchChromium, serveDist, watchedPage } from './harness.mjs';
+import { artifacts, launchChromium, pageErrors, reportPolicyViolations, serveDist, watchedPage } from './harness.mjs';
 import { exportImport, phyRoundTrip, refusedFrequency, shot, tab, titles } from './journeys.mjs';
 
 
@@ -50,6 +50,38 @@ test('the page opens connected to the simulated modem, which reports its reset',
   await page.locator('#traffic-table tbody tr', { hasText: 'BIO_ResetIndication' }).first().click();
   assert.match(await page.textContent('#traffic-details pre'), /"reset_cause": "Power-on reset"|"reset_cause"/);
   await shot(page, 'traffic');
+});
+
+test('the page is strict: its Content-Security-Policy allows no eval and refuses inline and foreign scripts', async () => {
+  const context = await browser.newContext();
+  const page = await context.newPage();
+  const errors = pageErrors(page);
+  await reportPolicyViolations(page);
+  await page.goto(base + '?profile=st7580');
+  await page.locator('#conn-state.ok').waitFor({ timeout: 15_000 });
+  assert.deepEqual(errors, [], 'the console itself runs under its policy');
+  const policy = await page.getAttribute('meta[http-equiv="Content-Security-Policy"]', 'content');
+  const script = policy.split(';').map((d) => d.trim()).find((d) => d.startsWith('script-src'));
+  assert.match(script, /^script-src 'self' 'wasm-unsafe-eval'( 'sha256-[A-Za-z0-9+/=]+')+$/, policy);
+  assert.doesNotMatch(policy, /\bws:/, 'no live-reload websocket in the release build');
+  // What injected markup would try: each refused, and reported. (eval is
+  // not tried here: code Playwright evaluates is exempt from the page's
+  // policy; the policy above names no 'unsafe-eval'.)
+  const outcome = await page.evaluate(async () => {
+    const inline = document.createElement('script');
+    inline.textContent = 'window.pwned = "inline"';
+    document.head.append(inline);
+    const foreign = document.createElement('script');
+    foreign.src = 'https://example.com/x.js';
+    document.head.append(foreign);
+    await new Promise((r) => setTimeout(r, 200));
+    return { pwned: window.pwned ?? null };
+  });
+  assert.deepEqual(outcome, { pwned: null });
+  const violations = errors.filter((e) => e.startsWith('Content-Security-Policy violation'));
+  assert.ok(violations.some((v) => v.includes('script-src-elem refused inline')), errors.join('\n'));
+  assert.ok(violations.some((v) => v.includes('example.com')), errors.join('\n'));
+  await context.close();
 });
 
 test('ping shows the PingConfirm and its round-trip time', async (t) => {

@@ -84,12 +84,25 @@ export function pageErrors(page) {
 }
 
 /**
+ * Every Content-Security-Policy violation in `page` becomes a console
+ * error (so a watched page fails on it), with what was refused.
+ */
+export function reportPolicyViolations(page) {
+  return page.addInitScript(() =>
+    addEventListener('securitypolicyviolation', (e) =>
+      console.error(`Content-Security-Policy violation: ${e.effectiveDirective} refused ${e.blockedURI || 'inline'} (${e.sourceFile}:${e.lineNumber})`),
+    ),
+  );
+}
+
+/**
  * A new page in `context`; after the test `t` the context is closed and
  * the test fails if the page reported an error.
  */
 export async function watchedPage(t, context) {
   const page = await context.newPage();
   const errors = pageErrors(page);
+  reportPolicyViolations(page);
   t.after(async () => {
     await context.close();
     assert.deepEqual(errors, [], 'no errors in the page');

@@ -6,6 +6,7 @@
 // after Trunk: the console's 350 KiB budget counts every JS file, and
 // Trunk's own minifier leaves these two as they are. The sources keep
 // their comments; only the copies the browser downloads are minified.
+// Last, it makes the page's Content-Security-Policy strict (strictPolicy).
 //
 // node minify-dist.mjs [DIST]   (default: ../../dist)
 
@@ -42,11 +43,12 @@ for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sor
   const file = path.join(dist, name);
   const original = await fs.readFile(file, 'utf8');
   let before = original;
-  // The service worker is a classic script; the wasm-bindgen glue a module.
-  const module = name !== 'sw.js';
-  if (module) before = dropStreamClasses(before);
+  // The wasm-bindgen glue (beside its wasm) is a module; the service
+  // worker and its registration are classic scripts.
   const wasmFile = path.join(dist, name.replace(/\.js$/, '_bg.wasm'));
-  const wasm = module ? await fs.readFile(wasmFile).catch(() => null) : null;
+  const wasm = await fs.readFile(wasmFile).catch(() => null);
+  const module = wasm !== null;
+  if (module) before = dropStreamClasses(before);
   if (wasm) {
     const short = shortenNames(wasm, before);
     before = short.js;
@@ -62,4 +64,40 @@ for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sor
   if (html.includes(old)) html = html.replaceAll(old, sri(out.code));
   console.log(`minify-dist: ${name} ${before.length} -> ${out.code.length} bytes`);
 }
+
+/**
+ * index.html's Content-Security-Policy made strict for the release build:
+ * the development server's allowances (index.html says which) are
+ * replaced by the SHA-256 of each inline script left, Trunk's loader.
+ * A page without the policy, or a policy without those allowances, is an
+ * error: the release build never ships without it.
+ */
+function strictPolicy(page) {
+  const meta = /<meta\b[^>]*http-equiv=["']?Content-Security-Policy["']?[^>]*>/i.exec(page);
+  const content = meta && /content="([^"]*)"/.exec(meta[0]);
+  if (!content) throw new Error('minify-dist: index.html has no Content-Security-Policy');
+  const hashes = [...page.matchAll(/<script\b([^>]*)>([\s\S]*?)<\/script>/g)]
+    .filter(([, attributes]) => !/\bsrc=/.test(attributes))
+    .map(([, , body]) => `'sha256-${crypto.createHash('sha256').update(body).digest('base64')}'`);
+  let relaxed = 0;
+  const strict = content[1]
+    .split(';')
+    .map((d) => d.trim())
+    .map((d) => {
+      const [name, ...sources] = d.split(/\s+/);
+      const kept = sources.filter((x) => {
+        const dev = (name === 'script-src' && x === "'unsafe-inline'") || (name === 'connect-src' && x === 'ws:');
+        relaxed += dev;
+        return !dev;
+      });
+      if (name === 'script-src') kept.push(...hashes);
+      return [name, ...kept].join(' ');
+    })
+    .join('; ');
+  if (relaxed !== 2) throw new Error(`minify-dist: the policy's development allowances are not as index.html says: ${content[1]}`);
+  console.log(`minify-dist: Content-Security-Policy: ${strict}`);
+  return page.replace(meta[0], meta[0].replace(content[0], `content="${strict}"`));
+}
+
+html = strictPolicy(html);
 await fs.writeFile(path.join(dist, 'index.html'), html);

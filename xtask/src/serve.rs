@@ -23,6 +23,10 @@ pub fn serve(port: u16, release: bool) -> Result {
     }
     println!();
     println!("serve: the console will be at http://127.0.0.1:{port}/ (Ctrl-C to stop)");
+    println!(
+        "serve: its Content-Security-Policy allows inline scripts and ws: for Trunk's loader and \
+         live reload; `cargo xtask dist` builds the strict page (docs/console.md)"
+    );
     println!("serve: $ {cmd}");
     cmd.run()
 }
