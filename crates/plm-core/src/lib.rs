@@ -20,6 +20,7 @@
 //!   prints and the console's traffic inspector shows.
 //! - [`decode_app`]: the same view of the controller board's application
 //!   frames, on its USART and on the power line.
+//! - [`file`]: the size cap and the text check of every file read.
 //! - [`json`]: the JSON values, writer and parser those views and the
 //!   console's files use (byte for byte what serde_json writes).
 //!
@@ -48,6 +49,7 @@ pub mod chip;
 pub mod decode;
 pub mod decode_app;
 pub mod field;
+pub mod file;
 pub mod hex;
 pub mod json;
 pub mod link;

@@ -143,6 +143,25 @@ proptest! {
         }
     }
 
+    /// Any bytes at all, as a file handed to the console: read as text,
+    /// then as JSON, each refusal in words (tests/hostile_files.rs has
+    /// the table of damaged files).
+    #[test]
+    fn any_bytes_are_read_or_refused_in_words(
+        bytes in vec(prop_oneof![
+            prop::sample::select(b"[]{}\",:\\ 0123456789-.eu".to_vec()),
+            any::<u8>(),
+        ], 0..200),
+    ) {
+        match plm_core::file::text(&bytes) {
+            Err(why) => prop_assert!(why.starts_with("the file ")),
+            Ok(text) => match (parse(text), serde_json::from_str::<Value>(text)) {
+                (Err(e), _) => prop_assert!(e.to_string().contains("expected")),
+                (Ok(_), b) => prop_assert!(b.is_ok() || text.contains('e')),
+            },
+        }
+    }
+
     #[test]
     fn decoded_elements_go_out_and_come_back_whole(
         dialect in prop_oneof![Just(Dialect::St7580), Just(Dialect::St7570)],

@@ -11,6 +11,12 @@ use core::fmt;
 /// risking the stack; serde_json refuses the 128th level too.
 const MAX_DEPTH: usize = 127;
 
+/// Numbers longer than this are refused: a number kept as its text
+/// ([`Json::Number`]) is never that long in a file plm-core wrote, and a
+/// file of one ten-megabyte number is not a traffic log (RFC 8259 section
+/// 9 lets a parser limit numbers).
+const MAX_NUMBER: usize = 100;
+
 /// Where a text stops being JSON, and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ParseError {
@@ -62,7 +68,10 @@ impl Parser<'_> {
         let line = before.matches('\n').count() + 1;
         let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
         let found = match self.text[self.pos..].chars().next() {
-            Some(c) if c.is_control() => alloc::format!("U+{:04X}", u32::from(c)),
+            // Control characters and invisible ones (a byte order mark).
+            Some(c) if c.is_control() || c == '\u{feff}' => {
+                alloc::format!("U+{:04X}", u32::from(c))
+            }
             Some(c) => alloc::format!("`{c}`"),
             None => "the end of the text".into(),
         };
@@ -141,11 +150,11 @@ impl Parser<'_> {
 
     fn object(&mut self, depth: usize) -> Result<Json, ParseError> {
         self.pos += 1;
-        let mut o = Object::new();
+        let mut members = Vec::new();
         self.skip_whitespace();
         if self.peek() == Some(b'}') {
             self.pos += 1;
-            return Ok(Json::Object(o));
+            return Ok(Json::Object(Object::new()));
         }
         loop {
             self.skip_whitespace();
@@ -154,15 +163,13 @@ impl Parser<'_> {
             }
             let key = self.string()?;
             self.expect(b':', "`:`")?;
-            // A key given twice keeps its first place and its last value,
-            // as serde_json reads it.
-            o.insert(key, self.value(depth)?);
+            members.push((key, self.value(depth)?));
             self.skip_whitespace();
             match self.peek() {
                 Some(b',') => self.pos += 1,
                 Some(b'}') => {
                     self.pos += 1;
-                    return Ok(Json::Object(o));
+                    return Ok(Json::Object(Object(once_each(members))));
                 }
                 _ => return Err(self.error("`,` or `}`")),
             }
@@ -199,6 +206,10 @@ impl Parser<'_> {
             return Err(self.error("the end of the number (no digit after a leading 0)"));
         }
         let text = &self.text[start..self.pos];
+        if text.len() > MAX_NUMBER {
+            self.pos = start;
+            return Err(self.error("a number of at most 100 characters"));
+        }
         Ok(match text.parse::<i64>() {
             // `-0` is not how an i64 is written: keep it as text.
             Ok(n) if whole && text != "-0" => Json::Int(n),
@@ -309,4 +320,39 @@ impl Parser<'_> {
         }
         Ok(n)
     }
+}
+
+/// An object's members with each key once: a key given twice keeps its
+/// first place and its last value, as serde_json reads it. Sorted rather
+/// than looked up member by member, so that an object of a million keys
+/// (a hostile file) takes as long as sorting them, not a million squared.
+fn once_each(mut members: Vec<(String, Json)>) -> Vec<(String, Json)> {
+    let mut order: Vec<usize> = (0..members.len()).collect();
+    // Stable: members with the same key stay in the order they came.
+    order.sort_by(|&a, &b| members[a].0.cmp(&members[b].0));
+    let mut dropped = Vec::new();
+    let mut i = 0;
+    while i < order.len() {
+        let mut j = i;
+        while j + 1 < order.len() && members[order[j + 1]].0 == members[order[i]].0 {
+            j += 1;
+        }
+        if j > i {
+            let last = core::mem::replace(&mut members[order[j]].1, Json::Null);
+            members[order[i]].1 = last;
+            dropped.extend_from_slice(&order[i + 1..=j]);
+        }
+        i = j + 1;
+    }
+    if dropped.is_empty() {
+        return members;
+    }
+    dropped.sort_unstable();
+    let mut next = dropped.iter().peekable();
+    members
+        .into_iter()
+        .enumerate()
+        .filter(|(k, _)| next.next_if_eq(&k).is_none())
+        .map(|(_, m)| m)
+        .collect()
 }

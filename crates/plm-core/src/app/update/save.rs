@@ -122,8 +122,17 @@ impl Update {
             5 => Phase::Over,
             _ => return Err("the saved update's phase is unknown".into()),
         };
+        let segments = header.segments();
+        if n > segments {
+            return Err(format!(
+                "the saved update's broadcast is at segment {n}, past the image's {segments}"
+            ));
+        }
         let sent = r.u64()?;
         let count = r.u16()?;
+        if count == 0 {
+            return Err("the saved update has no board".into());
+        }
         let mut targets = Vec::new();
         for _ in 0..count {
             let mut address = Address([0; 6]);
@@ -135,9 +144,14 @@ impl Update {
                 1 => {
                     let asked = r.u8()?;
                     let n = r.u16()?;
-                    let missing = (0..n)
+                    let missing: Vec<usize> = (0..n)
                         .map(|_| r.u16().map(usize::from))
                         .collect::<Result<_, _>>()?;
+                    if let Some(m) = missing.iter().find(|&&m| m >= segments) {
+                        return Err(format!(
+                            "a saved board misses segment {m}, past the image's {segments}"
+                        ));
+                    }
                     BoardState::Receiving { missing, asked }
                 }
                 2 => BoardState::Complete,
@@ -154,6 +168,9 @@ impl Update {
                 }
                 _ => return Err("a saved board's state is unknown".into()),
             };
+            if targets.iter().any(|t: &Target| t.address == address) {
+                return Err("the saved update names a board twice".into());
+            }
             targets.push(Target {
                 address,
                 rechecked: tag == 4,
