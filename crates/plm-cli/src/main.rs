@@ -352,11 +352,14 @@ fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
 
 fn decode(args: DecodeArgs) -> Result<(), String> {
     let text = if args.hex.is_empty() {
-        let mut s = String::new();
+        let mut s = Vec::new();
         io::stdin()
-            .read_to_string(&mut s)
+            .take(plm_core::file::FILE_MAX as u64 + 1)
+            .read_to_end(&mut s)
             .map_err(|e| format!("cannot read stdin: {e}"))?;
-        s
+        plm_core::file::text(&s)
+            .map_err(|e| format!("cannot read stdin: {e}"))?
+            .to_string()
     } else {
         args.hex.join(" ")
     };

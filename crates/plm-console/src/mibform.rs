@@ -418,6 +418,38 @@ mod tests {
             .starts_with("not a profile"));
     }
 
+    /// A profile cut short, with a byte changed anywhere, or not UTF-8
+    /// text, is refused in words (or, changed where the value stays
+    /// valid, read and checked as any profile), never a panic.
+    #[test]
+    fn a_damaged_profile_is_refused_in_words() {
+        let chip = plm_core::chip::St7580::default();
+        let mut values = MibValues::default();
+        for i in [index::PHY_CONFIG, index::MODEM_CONFIG] {
+            values.insert(i as u16, object(i).unwrap().default.to_vec());
+        }
+        let text = profile_json(&chip, &values).into_bytes();
+        let read = |b: &[u8]| plm_core::file::text(b).and_then(|t| parse_profile(&chip, t));
+        assert!(read(&text).is_ok());
+        for n in 0..text.len() {
+            assert!(read(&text[..n]).unwrap_err().len() > 15, "cut at {n}");
+        }
+        for i in 0..text.len() {
+            for bit in [0x01, 0x20, 0x80] {
+                let mut b = text.clone();
+                b[i] ^= bit;
+                if let Err(why) = read(&b) {
+                    assert!(why.len() > 15, "{why}");
+                }
+            }
+        }
+        let utf16: Vec<u8> = text.iter().flat_map(|&b| [b, 0]).collect();
+        assert!(read(&[&[0xFE, 0xFF][..], &utf16].concat())
+            .unwrap_err()
+            .contains("UTF-16"));
+        assert!(read(&utf16).unwrap_err().contains("NUL byte"));
+    }
+
     /// Issue 12: the ST7570's profile files come from the same code, read
     /// its MIB (16-bit indexes, Table 71), leave out the counters a write
     /// resets, and refuse a profile of the other chip.

@@ -476,4 +476,34 @@ mod tests {
         assert!(log.import("nothing here").is_err());
         assert_eq!(log.len(), 2, "a failed import keeps the log");
     }
+
+    /// A damaged or hostile file, read as the Traffic import reads it
+    /// (plm_core::file::text, then the import): refused in words, the
+    /// log as it was.
+    #[test]
+    fn a_damaged_log_file_is_refused_and_the_log_kept() {
+        let mut log = log();
+        let before = log.export();
+        let line = before.lines().next().unwrap().as_bytes().to_vec();
+        let mut files: Vec<Vec<u8>> = (0..line.len()).map(|n| line[..n].to_vec()).collect();
+        files.extend([
+            [
+                &[0xFF, 0xFE][..],
+                &line.iter().flat_map(|&b| [b, 0]).collect::<Vec<_>>(),
+            ]
+            .concat(),
+            [&line[..], b"\xC3("].concat(),
+            [&line[..5], b"\0", &line[5..]].concat(),
+            vec![b'['; plm_core::file::FILE_MAX + 1],
+            "9".repeat(1 << 20).into_bytes(),
+            "{\"a\":".repeat(1 << 18).into_bytes(),
+        ]);
+        for bytes in files {
+            let why = plm_core::file::text(&bytes)
+                .and_then(|text| log.import(text))
+                .unwrap_err();
+            assert!(why.len() > 15, "{why}");
+            assert_eq!(log.export(), before, "{why}");
+        }
+    }
 }

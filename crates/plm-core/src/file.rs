@@ -19,11 +19,13 @@ use alloc::string::String;
 /// firmware image (60 KiB) or a profile (a few KiB) is far below it.
 pub const FILE_MAX: usize = 16 * 1024 * 1024;
 
-/// Refuses a file of `len` bytes when it is larger than [`FILE_MAX`].
+/// Refuses a file of `len` bytes when it is larger than [`FILE_MAX`]
+/// (the message does not repeat `len`: a reader that stops one byte past
+/// the cap does not know the whole size).
 pub fn check_size(len: u64) -> Result<(), String> {
     if len > FILE_MAX as u64 {
         return Err(format!(
-            "the file is {len} bytes: files larger than {FILE_MAX} bytes (16 MiB) are not read"
+            "the file is larger than {FILE_MAX} bytes (16 MiB), the most the console and plm read"
         ));
     }
     Ok(())

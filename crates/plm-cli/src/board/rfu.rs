@@ -77,10 +77,25 @@ impl State {
     }
 }
 
+/// The bytes of a file, refused (as an `InvalidData` error, in words)
+/// past [`plm_core::file::FILE_MAX`] without reading more than one byte
+/// beyond it: a device or a huge file named by mistake costs nothing.
+fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let cap = plm_core::file::FILE_MAX as u64;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(cap + 1)
+        .read_to_end(&mut bytes)?;
+    plm_core::file::check_size(bytes.len() as u64)
+        .map_err(|why| std::io::Error::new(std::io::ErrorKind::InvalidData, why))?;
+    Ok(bytes)
+}
+
 /// `plm board rfu`.
 pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
     let name = r.image.display().to_string();
-    let bytes = std::fs::read(&r.image)
+    let bytes = read_capped(&r.image)
         .map_err(|e| Failure::input(format!("cannot read the image {name}: {e}")))?;
     let info = image::check(&bytes)
         .and_then(|i| i.stating(r.release))
@@ -102,7 +117,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
     let shown = state.path.display().to_string();
 
     // A saved campaign is checked before the port is opened.
-    let saved = match (r.restart, std::fs::read(&state.path)) {
+    let saved = match (r.restart, read_capped(&state.path)) {
         (true, _) => None,
         (false, Ok(saved)) => Some(saved),
         (false, Err(e)) if e.kind() == std::io::ErrorKind::NotFound => None,
@@ -398,6 +413,25 @@ mod tests {
         assert_eq!(duration_words(42), "42 s");
         assert_eq!(duration_words(65), "1 min 05 s");
         assert_eq!(duration_words(3_725), "1 h 02 min");
+    }
+
+    #[test]
+    fn a_file_past_the_cap_is_refused_unread() {
+        let dir = std::env::temp_dir().join(format!("plm-cap-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("big.bin");
+        let f = std::fs::File::create(&path).unwrap();
+        f.set_len(plm_core::file::FILE_MAX as u64 * 4).unwrap();
+        let e = read_capped(&path).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidData);
+        assert!(
+            e.to_string()
+                .contains("larger than 16777216 bytes (16 MiB)"),
+            "{e}"
+        );
+        std::fs::write(&path, b"small").unwrap();
+        assert_eq!(read_capped(&path).unwrap(), b"small");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

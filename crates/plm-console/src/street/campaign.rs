@@ -311,7 +311,20 @@ mod tests {
             s.resume_update(vec![0; 10], &saved).is_err(),
             "another image"
         );
-        s.resume_update(image, &saved).unwrap();
+        s.resume_update(image.clone(), &saved).unwrap();
+        // A damaged save (cut short, or with a byte changed) is refused
+        // and the running campaign goes on as it was.
+        let running = s.campaign().unwrap().update.save();
+        for n in 0..saved.len() {
+            assert!(s.resume_update(image.clone(), &saved[..n]).is_err());
+        }
+        let mut wrong = saved.clone();
+        wrong[0] ^= 1;
+        assert!(s
+            .resume_update(image, &wrong)
+            .unwrap_err()
+            .contains("not a saved"));
+        assert_eq!(s.campaign().unwrap().update.save(), running);
         run(&mut s, 120 * S);
         let c = s.campaign().unwrap();
         assert!(

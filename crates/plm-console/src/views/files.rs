@@ -49,17 +49,20 @@ pub fn chosen_file(ev: &web_sys::Event) -> Option<web_sys::File> {
     file
 }
 
-/// The text of a file.
+/// The text of a file: refused in words when larger than
+/// [`plm_core::file::FILE_MAX`] (16 MiB, before it is read), or when it
+/// is not UTF-8 text ([`plm_core::file::text`]); a UTF-8 byte order mark
+/// is skipped. Read as bytes rather than with `File.text()`, which would
+/// turn bytes that are not UTF-8 into U+FFFD without a word.
 pub async fn read_text(file: &web_sys::File) -> Result<String, String> {
-    let text = wasm_bindgen_futures::JsFuture::from(file.text())
-        .await
-        .map_err(|e| format!("the file could not be read: {e:?}"))?;
-    text.as_string()
-        .ok_or_else(|| "the file is not text".to_string())
+    let bytes = read_bytes(file).await?;
+    plm_core::file::text(&bytes).map(str::to_string)
 }
 
-/// The bytes of a file.
+/// The bytes of a file; refused in words, before it is read, when larger
+/// than [`plm_core::file::FILE_MAX`] (16 MiB).
 pub async fn read_bytes(file: &web_sys::File) -> Result<Vec<u8>, String> {
+    plm_core::file::check_size(file.size() as u64)?;
     let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
         .await
         .map_err(|e| format!("the file could not be read: {e:?}"))?;
