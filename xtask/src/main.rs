@@ -6,6 +6,7 @@
 mod bench;
 #[cfg(test)]
 mod doc_toc;
+mod fuzz;
 mod serve;
 mod setup;
 mod test;
@@ -25,6 +26,8 @@ commands:
   test [--dry-run] [--no-setup]
                              setup, then every test suite; stops at the first failure
   bench                      run the benchmarks; each prints its own figures
+  fuzz [TARGET] [--time S]   fuzz TARGET (all in turn when none) for S seconds
+                             each (default 60); crashes go to fuzz/regressions/
   dist                       build the release console into dist/
   help                       this text
 ";
@@ -73,6 +76,21 @@ fn dispatch(args: &[String]) -> Result {
         "dist" => {
             Options::parse(rest, &[], &[])?;
             serve::dist()
+        }
+        "fuzz" => {
+            let (target, rest) = match rest.split_first() {
+                Some((t, more)) if !t.starts_with('-') => (Some(t.as_str()), more),
+                _ => (None, rest),
+            };
+            let opts = Options::parse(rest, &[], &["--time"])?;
+            let seconds =
+                match opts.value("--time") {
+                    None => fuzz::DEFAULT_SECONDS,
+                    Some(s) => s.parse().ok().filter(|&s: &u64| s != 0).ok_or_else(|| {
+                        format!("--time wants a whole number of seconds, not `{s}`")
+                    })?,
+                };
+            fuzz::run(target, seconds)
         }
         "bench" => {
             Options::parse(rest, &[], &[])?;

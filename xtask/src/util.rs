@@ -79,7 +79,8 @@ impl Cmd {
         self
     }
 
-    fn command(&self) -> Command {
+    /// The command, ready to spawn (for output read as it comes).
+    pub fn command(&self) -> Command {
         // The `cargo` that runs us (`$CARGO`) also runs our cargo commands,
         // so that a toolchain override applies to both.
         let program = match (self.program.as_str(), std::env::var_os("CARGO")) {
