@@ -36,10 +36,13 @@ fn replay(target: fn(&[u8]), inputs: impl IntoIterator<Item = (String, Vec<u8>)>
     failed
 }
 
+/// The files' bytes; a file gone since it was listed (a fuzzer running
+/// meanwhile replaces corpus files by smaller ones) is skipped.
 fn read(paths: Vec<PathBuf>) -> impl Iterator<Item = (String, Vec<u8>)> {
-    paths.into_iter().map(|p| {
-        let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-        (p.display().to_string(), bytes)
+    paths.into_iter().filter_map(|p| match std::fs::read(&p) {
+        Ok(bytes) => Some((p.display().to_string(), bytes)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => panic!("{}: {e}", p.display()),
     })
 }
 
