@@ -2,7 +2,9 @@
 //! decoders, parsers and link engines with libFuzzer through cargo-fuzz,
 //! without sanitizers, on the stable toolchain. The target bodies are
 //! `crates/plm-fuzz` (whose test replays the corpus in `cargo xtask
-//! test`); the binaries are `fuzz/`. A crash is copied into
+//! test`); the binaries are `fuzz/`. libFuzzer reads `fuzz/seeds/` and
+//! `fuzz/regressions/`, and keeps the inputs that reach new code in
+//! `fuzz/corpus/<target>/`. A crash is copied into
 //! `fuzz/regressions/<target>/`, where the replay test keeps running it.
 
 use crate::util::{fmt_duration, root, Cmd, Result};
@@ -132,6 +134,7 @@ fn fuzz_cmd(root: &Path, args: &[&str]) -> Cmd {
 
 fn run_target(root: &Path, target: &str, seconds: u64) -> Result<Report> {
     let corpus = format!("fuzz/corpus/{target}");
+    let seeds = format!("fuzz/seeds/{target}");
     let regressions = format!("fuzz/regressions/{target}");
     let artifacts = root.join("fuzz/artifacts").join(target);
     for dir in [root.join(&corpus), root.join(&regressions)] {
@@ -147,6 +150,7 @@ fn run_target(root: &Path, target: &str, seconds: u64) -> Result<Report> {
             "none",
             target,
             &corpus,
+            &seeds,
             &regressions,
             "--",
             &time,

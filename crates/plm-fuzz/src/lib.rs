@@ -4,8 +4,10 @@
 //!
 //! The libFuzzer binaries (`fuzz/fuzz_targets/`, built by `cargo xtask
 //! fuzz`) call [`targets`]; `tests/replay.rs` replays every file of
-//! `fuzz/corpus/<target>/` and `fuzz/regressions/<target>/` through the
-//! same functions, so a crash once found stays a regression test.
+//! `fuzz/seeds/<target>/` ([`seeds`]), `fuzz/corpus/<target>/` (what
+//! fuzzing kept) and `fuzz/regressions/<target>/` (every crash found)
+//! through the same functions, so a crash once found stays a regression
+//! test.
 
 pub mod input;
 pub mod seeds;

@@ -1,7 +1,7 @@
-//! Replays every fuzz target's corpus and every crash it found
-//! (`fuzz/corpus/<target>/`, `fuzz/regressions/<target>/`) and the seeds
-//! made from the golden vectors, through the same target bodies the
-//! libFuzzer binaries run. No open-ended fuzzing: the same files, the same
+//! Replays every fuzz target's seeds (`fuzz/seeds/<target>/`, made from
+//! the golden vectors), the corpus its fuzzing grew (`fuzz/corpus/`) and
+//! every crash it found (`fuzz/regressions/`), through the same target
+//! bodies the libFuzzer binaries run. No open-ended fuzzing: the same files, the same
 //! verdict, every time.
 
 use plm_fuzz::TARGETS;
@@ -47,17 +47,15 @@ fn read(paths: Vec<PathBuf>) -> impl Iterator<Item = (String, Vec<u8>)> {
 }
 
 #[test]
-fn every_corpus_file_and_every_crash_found_replays_without_panic() {
+fn every_seed_corpus_file_and_crash_found_replays_without_panic() {
     let fuzz = root().join("fuzz");
     let mut failed = Vec::new();
     for (name, target) in TARGETS {
-        let corpus = files(&fuzz.join("corpus").join(name));
-        assert!(!corpus.is_empty(), "fuzz/corpus/{name}/ has no input");
-        failed.extend(replay(*target, read(corpus)));
-        failed.extend(replay(
-            *target,
-            read(files(&fuzz.join("regressions").join(name))),
-        ));
+        let seeds = files(&fuzz.join("seeds").join(name));
+        assert!(!seeds.is_empty(), "fuzz/seeds/{name}/ has no input");
+        for dir in ["seeds", "corpus", "regressions"] {
+            failed.extend(replay(*target, read(files(&fuzz.join(dir).join(name)))));
+        }
     }
     assert!(
         failed.is_empty(),
@@ -67,7 +65,7 @@ fn every_corpus_file_and_every_crash_found_replays_without_panic() {
 }
 
 #[test]
-fn the_seeds_from_the_golden_vectors_replay_without_panic() {
+fn the_seeds_made_now_from_the_golden_vectors_replay_without_panic() {
     let seeds = plm_fuzz::seeds::all(&root()).expect("the golden vectors read");
     for (name, _) in TARGETS {
         assert!(

@@ -1,5 +1,5 @@
-//! Writes the seed corpus (`plm_fuzz::seeds`) into `fuzz/corpus/<target>/`
-//! as `seed-<name>` files; `cargo xtask fuzz` runs it before fuzzing.
+//! Writes the seed corpus (`plm_fuzz::seeds`) into `fuzz/seeds/<target>/`;
+//! `cargo xtask fuzz` runs it before fuzzing (the same files each time).
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -14,13 +14,13 @@ fn main() -> ExitCode {
         }
     };
     for (target, name, bytes) in &seeds {
-        let dir = root.join("fuzz/corpus").join(target);
-        let path = dir.join(format!("seed-{name}"));
+        let dir = root.join("fuzz/seeds").join(target);
+        let path = dir.join(name);
         if let Err(e) = std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, bytes)) {
             eprintln!("plm-fuzz-seed: {}: {e}", path.display());
             return ExitCode::FAILURE;
         }
     }
-    println!("plm-fuzz-seed: {} seeds in fuzz/corpus/", seeds.len());
+    println!("plm-fuzz-seed: {} seeds in fuzz/seeds/", seeds.len());
     ExitCode::SUCCESS
 }
