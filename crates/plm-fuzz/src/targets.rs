@@ -124,14 +124,18 @@ pub fn app_frame(data: &[u8]) {
 }
 
 /// A MAC frame from the power line (ST7570 UM 10.3): the long frame's
-/// fields, the MAC frame and `plm decode --line`'s view and its export.
+/// fields, the MAC frame (emitted again, it parses to itself) and `plm
+/// decode --line`'s view and its export.
 pub fn st7570_mac(data: &[u8]) {
     if let Ok(long) = LongFrame::new_checked(data) {
         let _ = (long.ns(), long.credit(), long.address(), long.pad_len());
         let _ = (long.m_sdu(), long.pad(), long.fcs_ok(), long.fcs_form());
         let _ = MacFrame::parse(&long);
     }
-    let _ = MacFrame::parse_bytes(data);
+    if let Ok(frame) = MacFrame::parse_bytes(data) {
+        let again = frame.emit().expect("a parsed MAC frame emits");
+        assert_eq!(MacFrame::parse_bytes(&again).as_ref(), Ok(&frame));
+    }
     let line = decode::decode_line(data);
     if let Err(why) = LineDecoded::from_json(&line.to_json()) {
         panic!("an exported line frame does not import: {why}");
