@@ -258,6 +258,34 @@ fn a_saved_campaign_that_does_not_fit_its_image_is_refused() {
         .contains("twice"));
 }
 
+#[test]
+fn a_saved_campaign_whose_waits_cannot_be_counted_is_refused() {
+    // Found by the saved_campaign fuzz target: a gap of 2^64-1 µs
+    // overflowed the time left.
+    let saved = saved_campaign();
+    let pacing = 7 + 1 + saved[7] as usize;
+    let refused = |at: usize, value: &[u8]| {
+        let mut bad = saved.clone();
+        bad[pacing + at..pacing + at + value.len()].copy_from_slice(value);
+        Update::resume(campaign_image(), &bad, 0).unwrap_err()
+    };
+    let huge = u64::MAX.to_be_bytes();
+    assert!(
+        refused(0, &huge).contains("gap of"),
+        "{}",
+        refused(0, &huge)
+    );
+    assert!(refused(8, &huge).contains("restart of"));
+    assert!(refused(16, &huge).contains("back-off of"));
+    assert!(refused(25, &[200]).contains("200 silences"));
+    let config = UpdateConfig {
+        backoff: UpdateConfig::LONGEST + 1,
+        ..UpdateConfig::default()
+    };
+    let a = [Address::from_u64(1)];
+    assert!(Update::new(9, None, campaign_image(), &a, config).is_err());
+}
+
 /// The bytes after a saved board's address, tag and counters, by its tag.
 fn first_board_len(b: &[u8]) -> usize {
     match b[0] {

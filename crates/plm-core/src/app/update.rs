@@ -73,6 +73,39 @@ impl UpdateConfig {
             ..UpdateConfig::default()
         }
     }
+
+    /// Longest gap, restart or back-off a campaign takes (ten minutes:
+    /// sixty times the defaults' longest).
+    pub const LONGEST: Duration = 600_000 * MS;
+    /// Most silences a board may be allowed (the back-off doubles after
+    /// each: sixteen from ten minutes is a year and a quarter).
+    pub const MOST_SILENCES: u8 = 16;
+
+    /// Refuses, in words, a pacing whose waits could not be counted in
+    /// microseconds (a saved campaign's, a caller's).
+    pub fn check(&self) -> Result<(), String> {
+        for (what, d) in [
+            ("gap", self.gap),
+            ("restart", self.restart),
+            ("back-off", self.backoff),
+        ] {
+            if d > Self::LONGEST {
+                return Err(format!(
+                    "a {what} of {} ms is over the {} ms a campaign waits at most",
+                    d / MS,
+                    Self::LONGEST / MS
+                ));
+            }
+        }
+        if self.silences > Self::MOST_SILENCES {
+            return Err(format!(
+                "{} silences allowed a board, over the {} whose doubling back-off can be waited",
+                self.silences,
+                Self::MOST_SILENCES
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for UpdateConfig {
@@ -208,6 +241,7 @@ impl Update {
         if targets.is_empty() {
             return Err("no board to update".into());
         }
+        config.check()?;
         Ok(Update {
             header: Header::of(
                 campaign,

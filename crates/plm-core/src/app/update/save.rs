@@ -111,6 +111,9 @@ impl Update {
             silences: r.u8()?,
             restarts: r.u8()?,
         };
+        config
+            .check()
+            .map_err(|why| format!("the saved update's pacing is refused: {why}"))?;
         let tag = r.u8()?;
         let n = r.u16()? as usize;
         let phase = match tag {
