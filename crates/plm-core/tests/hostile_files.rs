@@ -259,7 +259,7 @@ fn a_saved_campaign_that_does_not_fit_its_image_is_refused() {
 }
 
 #[test]
-fn a_saved_campaign_whose_waits_cannot_be_counted_is_refused() {
+fn a_saved_campaign_whose_waits_or_counts_cannot_be_counted_is_refused() {
     // Found by the saved_campaign fuzz target: a gap of 2^64-1 µs
     // overflowed the time left.
     let saved = saved_campaign();
@@ -278,6 +278,13 @@ fn a_saved_campaign_whose_waits_cannot_be_counted_is_refused() {
     assert!(refused(8, &huge).contains("restart of"));
     assert!(refused(16, &huge).contains("back-off of"));
     assert!(refused(25, &[200]).contains("200 silences"));
+    // Also found: a count of bytes sent near 2^64 overflowed the next segment's.
+    let sent = 24 + 3 + 3;
+    assert!(
+        refused(sent, &huge).contains("bytes sent"),
+        "{}",
+        refused(sent, &huge)
+    );
     let config = UpdateConfig {
         backoff: UpdateConfig::LONGEST + 1,
         ..UpdateConfig::default()

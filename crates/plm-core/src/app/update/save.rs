@@ -30,6 +30,10 @@ use alloc::vec::Vec;
 
 const MAGIC: &[u8; 7] = b"PLMRFU\x01";
 
+/// Most bytes a saved campaign may say it sent: 1 TiB, nine years of
+/// the fastest line (28.8 kbit/s), so that counting on cannot overflow.
+const SENT_MOST: u64 = 1 << 40;
+
 impl Update {
     /// The campaign's progress, to keep until [`Update::resume`].
     pub fn save(&self) -> Vec<u8> {
@@ -132,6 +136,11 @@ impl Update {
             ));
         }
         let sent = r.u64()?;
+        if sent > SENT_MOST {
+            return Err(format!(
+                "the saved update says {sent} bytes sent, more than a power line carries in years"
+            ));
+        }
         let count = r.u16()?;
         if count == 0 {
             return Err("the saved update has no board".into());
