@@ -15,6 +15,7 @@
 
 use super::client::{self, Chunk, Client, Purge};
 use plm_sim::Ports;
+use std::collections::VecDeque;
 use std::io::Write;
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
@@ -50,12 +51,18 @@ impl Stopper {
     }
 }
 
+/// How long a new client of a node with a client waits for that client
+/// to be seen gone before it is refused as busy.
+const REOPEN_GRACE: Duration = Duration::from_millis(200);
+
 /// The simulation and its ports, served until stopped.
 pub struct Served {
     sim: Box<dyn Ports + Send>,
     /// Each node's answer to RFC 2217 SIGNATURE.
     signatures: Vec<String>,
     wakes: Receiver<Wake>,
+    /// Wakes put aside while a new client waited for the one before it.
+    later: VecDeque<Wake>,
     sender: Sender<Wake>,
     clients: Vec<Option<Client>>,
     /// Wall-clock time of simulated time 0: when the first client came.
@@ -83,6 +90,7 @@ impl Served {
             sim,
             signatures,
             wakes,
+            later: VecDeque::new(),
             sender,
             clients,
             origin: None,
@@ -99,6 +107,7 @@ impl Served {
     pub fn run(mut self) {
         loop {
             let wake = match self.deadline() {
+                _ if !self.later.is_empty() => self.later.pop_front(),
                 Some(at) => {
                     match self
                         .wakes
@@ -177,8 +186,25 @@ impl Served {
     }
 
     fn accepted(&mut self, node: usize, stream: TcpStream, peer: SocketAddr) {
-        if self.clients[node].is_some() {
-            return refuse(stream, peer);
+        // A host that closes its port and opens it again at once: its
+        // close and its new connection reach the loop from two threads,
+        // in either order. The new one waits a moment for the old one to
+        // be seen gone (serving every client meanwhile) before it is
+        // refused as busy.
+        let until = Instant::now() + REOPEN_GRACE;
+        while self.clients[node].is_some() {
+            let wait = self.deadline().map_or(until, |at| at.min(until));
+            match self
+                .wakes
+                .recv_timeout(wait.saturating_duration_since(Instant::now()))
+            {
+                Ok(w @ (Wake::Data { .. } | Wake::Closed { .. })) => self.handle(w),
+                Ok(w) => self.later.push_back(w),
+                Err(RecvTimeoutError::Timeout) if Instant::now() < until => {}
+                Err(_) => return refuse(stream, peer),
+            }
+            self.advance();
+            self.forward();
         }
         // The modems power on with the first client (simulated time 0).
         self.origin.get_or_insert_with(Instant::now);
