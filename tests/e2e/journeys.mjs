@@ -149,11 +149,13 @@ export async function macAsk(page) {
   const before = await page.locator('#sfsk-received-table tbody tr').count();
   const result = page.locator('#sfsk-result');
   // A Server's alarm burst on the line makes the MAC layer busy (LM_TU:
-  // "send again"), and a technician sends again.
+  // "send again") while the Client repeats it (7.2.3), and a technician
+  // sends again a moment later: an immediate retry lands in the same burst.
   for (let tries = 1; ; tries++) {
     await page.click('#sfsk-send-btn');
     await result.filter({ hasText: /^(?!sending)./ }).waitFor({ timeout: 25_000 });
-    if (tries === 3 || !(await result.textContent()).startsWith('CMD_DataConfirm: LM_TU')) break;
+    if (tries === 6 || !(await result.textContent()).startsWith('CMD_DataConfirm: LM_TU')) break;
+    await page.waitForTimeout(700);
   }
   assert.equal(await result.textContent(), 'CMD_DataConfirm: LM_OK');
   const answers = page.locator('#sfsk-received-table tbody tr', { hasText: '001h → ' }).filter({ hasText: '"!001 phase' });
