@@ -8,6 +8,7 @@
 //! attenuation growing with the distance along the street, and an SNR
 //! each modulation needs.
 
+use crate::st7570::line::power_sum;
 use plm_core::st7580::mib::PhyConfig;
 use plm_core::st7580::{Channel, Modulation};
 use plm_core::time::{Duration, Instant};
@@ -23,6 +24,14 @@ pub const FREQUENCY_TOLERANCE: u32 = 500;
 const PSK_SYNC_BITS: u64 = 32;
 /// Bit rate of the PSK preamble, unique word and mode header.
 const PSK_SYNC_RATE: u64 = 9_600;
+/// Capture: of frames overlapping on one receiver channel, one whose level
+/// is this many dB above the others (their powers summed) is received
+/// despite them, the others are lost. A model decision (the seeds give no
+/// figure): B-PSK's required SNR (4 dB) plus 2 dB, as the S-FSK line's
+/// capture is its decoding SNR plus 2 dB (`st7570::line::CAPTURE_DB`);
+/// the survivor must still meet its own modulation's SNR with the others
+/// counted as noise, so a faster modulation needs more.
+pub const CAPTURE_DB: f64 = 6.0;
 
 /// Conditions on the line.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,6 +44,10 @@ pub struct LineConfig {
     pub attenuation_per_hop_db: f64,
     /// Probability a frame is lost at a receiver that could hear it.
     pub loss: f64,
+    /// Capture margin, dB: of overlapping frames on one receiver channel,
+    /// one this much stronger than the others survives ([`CAPTURE_DB`] by
+    /// default); `None`: every overlap loses them all.
+    pub capture_db: Option<f64>,
     /// Probability a received frame has one byte corrupted.
     pub corruption: f64,
     /// Extra attenuation between nodes on different mains phases (node
@@ -50,6 +63,7 @@ impl Default for LineConfig {
             attenuation_db: 30.0,
             attenuation_per_hop_db: 2.0,
             loss: 0.0,
+            capture_db: Some(CAPTURE_DB),
             corruption: 0.0,
             phase_coupling_db: 0.0,
         }
@@ -141,6 +155,30 @@ pub fn required_snr(modulation: Modulation) -> f64 {
         Modulation::EightPsk => 12.0,
         Modulation::BFsk => 9.0,
         Modulation::Reserved => f64::INFINITY,
+    }
+}
+
+/// What a receiver makes of a frame it hears at `level` (dBµV) while
+/// other frames overlap it on its channel: `others` their powers summed
+/// and `strongest` the strongest of them (`-inf` both when none did).
+/// Its SNR, the others counted as noise, when it is received; why it is
+/// lost otherwise: outdone by [`LineConfig::capture_db`] or more, or a
+/// collision that nobody wins.
+pub fn overlap(
+    line: &LineConfig,
+    modulation: Modulation,
+    level: f64,
+    others: f64,
+    strongest: f64,
+) -> Result<f64, &'static str> {
+    if others == f64::NEG_INFINITY {
+        return Ok(level - line.noise_dbuv);
+    }
+    let snr = level - power_sum([line.noise_dbuv, others]);
+    match line.capture_db {
+        Some(c) if level - others >= c && snr >= required_snr(modulation) => Ok(snr),
+        Some(c) if strongest - level >= c => Err("lost to a stronger frame"),
+        _ => Err("collision"),
     }
 }
 

@@ -19,6 +19,7 @@ use crate::echo::EchoHost;
 use crate::line::{self, LineConfig, Transmission};
 use crate::modem::{Reception, St7580};
 use crate::rng::Rng;
+use crate::st7570::line::power_sum;
 use crate::uart::{ByteFaults, OneShot, Wire};
 use plm_core::link::host::Transmit;
 use plm_core::mib::MibError;
@@ -288,9 +289,14 @@ struct ActiveRx {
     id: u64,
     tx: Transmission,
     channel: Channel,
-    snr_db: f64,
     level: f64,
-    collided: bool,
+    /// The other frames that overlapped it on its channel: their powers
+    /// summed and the strongest, dBµV (`-inf` while none did).
+    others: f64,
+    strongest: f64,
+    /// Why it is lost whatever the others were (its receiver started
+    /// sending).
+    dropped: Option<&'static str>,
 }
 
 #[derive(Debug, Clone)]
@@ -1003,7 +1009,7 @@ impl Sim {
         });
         // A modem that starts sending drops what it was receiving.
         for rx in &mut self.nodes[tx.from].rx {
-            rx.collided = true;
+            rx.dropped = Some("receiver started transmitting");
         }
         self.touch(tx.from);
         self.seq += 1;
@@ -1040,19 +1046,23 @@ impl Sim {
                 continue;
             }
             let n = &mut self.nodes[to];
-            // Two frames on one channel at once: neither survives.
-            let mut collided = false;
+            // Frames on one channel at once: each counts the others, and
+            // at its end `line::overlap` says which one survives, if any.
+            let (mut others, mut strongest) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
             for other in n.rx.iter_mut().filter(|r| r.channel == channel) {
-                other.collided = true;
-                collided = true;
+                other.others = power_sum([other.others, level]);
+                other.strongest = other.strongest.max(level);
+                others = power_sum([others, other.level]);
+                strongest = strongest.max(other.level);
             }
             n.rx.push(ActiveRx {
                 id,
                 tx: tx.clone(),
                 channel,
-                snr_db,
                 level,
-                collided,
+                others,
+                strongest,
+                dropped: None,
             });
             n.modem.set_receiving(true);
             self.touch(to);
@@ -1070,25 +1080,34 @@ impl Sim {
         let rx = n.rx.remove(pos);
         n.modem.set_receiving(false);
         let from = rx.tx.from;
-        let margin = rx.snr_db - line::required_snr(rx.tx.modulation);
-        let why = if rx.collided {
-            Some("collision")
-        } else if !n.modem.is_on() {
-            Some("receiver restarting")
-        } else if self.rng.chance(self.line.loss) {
-            Some("lost on the line")
-        } else {
-            None
+        let heard = match rx.dropped {
+            Some(why) => Err(why),
+            None => line::overlap(
+                &self.line,
+                rx.tx.modulation,
+                rx.level,
+                rx.others,
+                rx.strongest,
+            ),
         };
-        if let Some(why) = why {
-            self.record(LineEvent::Missed {
-                at: now,
-                from,
-                to,
-                why,
-            });
-            return;
-        }
+        let heard = match heard {
+            Ok(_) if !n.modem.is_on() => Err("receiver restarting"),
+            Ok(_) if self.rng.chance(self.line.loss) => Err("lost on the line"),
+            heard => heard,
+        };
+        let snr_db = match heard {
+            Ok(snr_db) => snr_db,
+            Err(why) => {
+                self.record(LineEvent::Missed {
+                    at: now,
+                    from,
+                    to,
+                    why,
+                });
+                return;
+            }
+        };
+        let margin = snr_db - line::required_snr(rx.tx.modulation);
         // Within 3 dB of the modulation's threshold, a frame comes through
         // with a bit error one time in three (model).
         let weak = margin < 3.0 && self.rng.chance(1.0 / 3.0);
@@ -1102,13 +1121,13 @@ impl Sim {
             at: now,
             from,
             to,
-            snr_db: rx.snr_db,
+            snr_db,
             corrupted,
         });
         let snr = if rx.tx.modulation == Modulation::BFsk {
             255
         } else {
-            rx.snr_db.round().clamp(-128.0, 127.0) as i8 as u8
+            snr_db.round().clamp(-128.0, 127.0) as i8 as u8
         };
         self.nodes[to].modem.receive(
             now,
