@@ -47,6 +47,12 @@ pub const INPUT_LEVELS: u8 = 0b0000_0011;
 /// 12h, "HID board response timeout" (model).
 pub const HID_TIMEOUT: plm_core::time::Duration = 100 * plm_core::time::MS;
 
+/// The firmware hands each line frame it makes to its modem after a delay
+/// drawn uniformly from 0 to this, never before the frame it made before
+/// (its main loop, its interrupts; the seed gives no figure): a model
+/// decision, so that nothing above the line is tuned to a perfect clock.
+pub const FIRMWARE_JITTER: plm_core::time::Duration = 4 * plm_core::time::MS;
+
 /// The address of a street's node.
 pub fn street_address(node: usize) -> Address {
     Address::from_u64(ADDRESS_BASE + node as u64)
@@ -65,6 +71,15 @@ pub struct BoardConfig {
     pub clock_offset: u64,
     /// The modulation its frames go out with.
     pub modulation: plm_core::st7580::Modulation,
+}
+
+/// A line frame the firmware made: when, and when it goes to the modem
+/// (drawn with [`FIRMWARE_JITTER`] before the board's turn ends).
+#[derive(Debug, Clone)]
+struct LineOut {
+    made: Instant,
+    due: Option<Instant>,
+    frame: LineFrame,
 }
 
 /// A pending MIB frame: who asked, and whether it was a write.
@@ -106,6 +121,8 @@ pub struct Board {
     rfu: RfuManager,
     /// The board protocol rule it breaks, if any (`plm sim --break`).
     breach: Option<Breach>,
+    /// Line frames made and not yet handed to the modem, oldest first.
+    line_out: VecDeque<LineOut>,
     /// Frames handled (for tests and views).
     pub handled: u64,
 }
@@ -143,6 +160,7 @@ impl Board {
             usart_out: VecDeque::new(),
             rfu: RfuManager::factory(now, FIRMWARE),
             breach: None,
+            line_out: VecDeque::new(),
             handled: 0,
         }
     }
@@ -175,6 +193,7 @@ impl Board {
         self.discovery_reply = None;
         self.mib_asks.clear();
         self.hid_answers.clear();
+        self.line_out.clear();
     }
 
     /// The same board with a USART to the outside host (a concentrator).
@@ -241,6 +260,7 @@ impl Board {
         );
         let t = earliest(t, self.hid_answers.front().map(|a| a.0));
         let t = earliest(t, self.rfu.poll_timeout());
+        let t = earliest(t, self.line_out.front().and_then(|o| o.due));
         earliest(t, self.usart_last.map(|t| t + USART_IDLE))
     }
 
@@ -323,6 +343,31 @@ impl Board {
                 }
                 _ => {}
             }
+        }
+        self.release_line(now, rng);
+    }
+
+    /// Draws when each new line frame goes ([`FIRMWARE_JITTER`]), and
+    /// hands those due to the modem.
+    fn release_line(&mut self, now: Instant, rng: &mut Rng) {
+        let mut after = now;
+        for o in self.line_out.iter_mut() {
+            let due = *o
+                .due
+                .get_or_insert_with(|| (o.made + rng.below(FIRMWARE_JITTER + 1)).max(after));
+            after = due;
+        }
+        while self
+            .line_out
+            .front()
+            .is_some_and(|o| o.due.is_some_and(|d| d <= now))
+        {
+            let o = self.line_out.pop_front().expect("front exists");
+            let cmd = Command::DlDataRequest(DataRequest {
+                params: self.params,
+                payload: o.frame.emit(),
+            });
+            self.engine.submit(now, cmd.to_frame());
         }
     }
 
@@ -597,12 +642,14 @@ impl Board {
         self.submit_line(now, &line);
     }
 
+    /// A line frame made now: it goes to the modem when
+    /// [`Board::release_line`] says.
     fn submit_line(&mut self, now: Instant, line: &LineFrame) {
-        let cmd = Command::DlDataRequest(DataRequest {
-            params: self.params,
-            payload: line.emit(),
+        self.line_out.push_back(LineOut {
+            made: now,
+            due: None,
+            frame: line.clone(),
         });
-        self.engine.submit(now, cmd.to_frame());
     }
 
     fn usart_send(&mut self, frame: AppFrame) {
