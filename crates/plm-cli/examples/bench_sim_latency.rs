@@ -21,6 +21,8 @@ fn main() {
             peers: plm_sim::Peers::EchoFollowing,
         },
         seed: 1,
+        loss: 0.0,
+        capture: true,
     })
     .expect("binds a loopback port");
     let addr = bound.addrs[0].to_string();

@@ -156,6 +156,16 @@ struct SimArgs {
     /// sets others reaches no Server.
     #[arg(long)]
     factory_servers: bool,
+    /// Each frame on the power line is lost at each receiver that could
+    /// hear it with probability P (from 0 to 1, 1 excluded; default 0):
+    /// a line that is not ideal.
+    #[arg(long, value_name = "P", default_value_t = 0.0, allow_negative_numbers = true, value_parser = loss_probability)]
+    loss: f64,
+    /// Two frames overlapping at a receiver are both lost whatever their
+    /// levels (by default one heard 6 dB or more above the other is
+    /// received, as on a real line: capture). ST7580 only.
+    #[arg(long)]
+    no_capture: bool,
     /// Seed of the simulation's random number generator.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -187,6 +197,16 @@ fn failure_rate(s: &str) -> Result<f64, String> {
         Ok(r) if (0.0..=60.0).contains(&r) => Ok(r),
         _ => Err(format!(
             "'{s}' is not a failure rate: a number of failures per lamp per lit hour, 0 to 60"
+        )),
+    }
+}
+
+fn loss_probability(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..1.0).contains(&p) => Ok(p),
+        _ => Err(format!(
+            "'{s}' is not a loss probability: a number from 0 up to but not including 1 \
+             (0.05: one frame in twenty lost at each receiver)"
         )),
     }
 }
@@ -236,6 +256,8 @@ fn sim(args: SimArgs) -> Result<(), String> {
         allow_remote: args.allow_remote,
         world,
         seed: args.seed,
+        loss: args.loss,
+        capture: !args.no_capture,
     })
 }
 
@@ -256,6 +278,14 @@ fn st7570_world(args: &SimArgs) -> Result<sim_server::World, String> {
                  boards and its other nodes are MAC Servers that answer, not echoing ST7580s"
             ));
         }
+    }
+    if args.no_capture {
+        return Err(format!(
+            "--no-capture cannot be used with --chip st7570: on its S-FSK line a frame {} dB \
+             above the others in its slot is always received (the ST7580 line's capture is \
+             the one that can be turned off)",
+            plm_sim::st7570::line::CAPTURE_DB
+        ));
     }
     let serve = usize::from(args.serve);
     let nodes = args

@@ -46,7 +46,7 @@ pub mod client;
 pub mod event_loop;
 
 pub use event_loop::{Served, Stopper, RATES};
-use plm_sim::{Attach, Peers, Sim, SimConfig};
+use plm_sim::{Attach, LineConfig, Peers, Sim, SimConfig};
 use std::net::{SocketAddr, TcpListener, ToSocketAddrs};
 
 /// Lamps on a street unless told otherwise (`--board` alone).
@@ -114,6 +114,12 @@ pub struct Options {
     pub allow_remote: bool,
     pub world: World,
     pub seed: u64,
+    /// Probability that a frame is lost at each receiver that could hear
+    /// it (`--loss`; [`plm_sim::LineConfig::loss`]).
+    pub loss: f64,
+    /// Capture on the ST7580 line (`--no-capture` turns it off;
+    /// [`plm_sim::LineConfig::capture_db`]).
+    pub capture: bool,
 }
 
 /// `plm sim`, bound and ready: its ports, what it says at start, and the
@@ -159,15 +165,17 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         servers_follow,
     } = opts.world
     {
-        return Ok(bind_st7570(
-            addrs,
-            listeners,
-            nodes.max(serve),
-            serve,
-            alarms,
+        use plm_sim::st7570::net::NetConfig;
+        let config = NetConfig::served_line(nodes.max(serve), serve, opts.seed);
+        let config = NetConfig {
             servers_follow,
-            opts.seed,
-        ));
+            line: plm_sim::st7570::line::SfskLine {
+                loss: opts.loss,
+                ..config.line.clone()
+            },
+            ..config
+        };
+        return Ok(bind_st7570(addrs, listeners, config, alarms));
     }
     let (config, what) = match opts.world {
         World::St7570 { .. } => unreachable!("served above"),
@@ -228,8 +236,14 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             Attach::Board => "plm sim: simulated street-light concentrator board (USART)".into(),
         })
         .collect();
+    let line = LineConfig {
+        loss: opts.loss,
+        capture_db: opts.capture.then_some(plm_sim::line::CAPTURE_DB),
+        ..config.line.clone()
+    };
     let sim = Sim::new(SimConfig {
         seed: opts.seed,
+        line,
         ..config
     });
     let mut banner = vec![format!(
@@ -265,6 +279,7 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             name.map_or("?", |x| x.0)
         ));
     }
+    banner.extend(line_banner(opts.loss, opts.capture));
     banner.push(
         "plm sim: the simulation powers on when the first client connects; Ctrl-C stops".into(),
     );
@@ -275,24 +290,34 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
     })
 }
 
-/// `plm sim --chip st7570`: an S-FSK line of `nodes` ST7570s, nodes
-/// 0..serve served at `addrs`, the others MAC Servers that configure
-/// themselves (taking on node 0's bit rate, f0 and f1 if
-/// `servers_follow`) and answer what is sent to them.
+/// What the banner says of a line that is not ideal (nothing for the
+/// defaults: no loss, capture on).
+fn line_banner(loss: f64, capture: bool) -> Vec<String> {
+    let mut said = Vec::new();
+    if loss > 0.0 {
+        said.push(format!(
+            "plm sim: each frame is lost at each receiver with probability {loss} (--loss)"
+        ));
+    }
+    if !capture {
+        said.push("plm sim: overlapping frames are all lost, none captured (--no-capture)".into());
+    }
+    said
+}
+
+/// `plm sim --chip st7570`: the S-FSK line of `config`
+/// ([`plm_sim::st7570::net::NetConfig::served_line`]), nodes 0..served served at `addrs`, the
+/// others MAC Servers that configure themselves (taking on node 0's bit
+/// rate, f0 and f1 if `servers_follow`) and answer what is sent to them.
 fn bind_st7570(
     addrs: Vec<SocketAddr>,
     listeners: Vec<TcpListener>,
-    nodes: usize,
-    serve: usize,
+    config: plm_sim::st7570::net::NetConfig,
     alarms: Option<u64>,
-    servers_follow: bool,
-    seed: u64,
 ) -> Bound {
-    use plm_sim::st7570::net::{NetConfig, Network};
-    let config = NetConfig {
-        servers_follow,
-        ..NetConfig::served_line(nodes, serve, seed)
-    };
+    use plm_sim::st7570::net::Network;
+    let (nodes, serve, seed) = (config.nodes, config.served, config.seed);
+    let (servers_follow, loss) = (config.servers_follow, config.line.loss);
     let repeaters = config.repeaters();
     let net = Network::new(config);
     let addr = addrs[0];
@@ -361,6 +386,7 @@ fn bind_st7570(
             nodes - 1
         ));
     }
+    banner.extend(line_banner(loss, true));
     banner.push(
         "plm sim: the simulation powers on when the first client connects; Ctrl-C stops".into(),
     );

@@ -129,6 +129,7 @@ fn docs_and_help_name_the_same_options() {
         ("lamp-failures", "0-60"),
         ("peers", "follow|factory"),
         ("listen", "127.0.0.1:7580"),
+        ("loss", "1 excluded"),
     ] {
         let item = section
             .split(&format!("\n- `--{name}"))
@@ -191,4 +192,44 @@ fn factory_servers_need_st7570_servers() {
     );
     let err = refused(&["--chip", "st7570", "--nodes", "1", "--factory-servers"]);
     assert!(err.contains("there is no Server"), "{err}");
+}
+
+#[test]
+fn a_loss_that_is_not_a_probability_below_1_is_refused_in_words() {
+    for p in ["1", "1.5", "-0.1", "NaN", "five percent"] {
+        let err = refused(&["--board", "--loss", p]);
+        assert!(
+            err.contains(&format!("'{p}' is not a loss probability")),
+            "--loss {p}: {err}"
+        );
+    }
+}
+
+/// The help and the docs give the line model's capture margin.
+#[test]
+fn no_capture_names_the_models_margin() {
+    let margin = format!("{} dB or more", plm_sim::line::CAPTURE_DB);
+    let out = Command::new(env!("CARGO_BIN_EXE_plm"))
+        .args(["sim", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8(out.stdout).unwrap();
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/cli.md")).unwrap();
+    for (what, text) in [("help", help), ("docs/cli.md", docs)] {
+        let entry = text.rsplit("--no-capture").next().unwrap_or("");
+        assert!(
+            entry.split("--seed").next().unwrap().contains(&margin),
+            "{what}: --no-capture should say {margin}"
+        );
+    }
+}
+
+#[test]
+fn no_capture_is_refused_with_chip_st7570() {
+    let err = refused(&["--chip", "st7570", "--no-capture"]);
+    assert!(
+        err.contains("--no-capture cannot be used with --chip st7570"),
+        "{err}"
+    );
 }

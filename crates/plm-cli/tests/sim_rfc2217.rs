@@ -443,3 +443,56 @@ fn serve_on_a_fixed_port_takes_the_ports_above_it() {
     );
     server.interrupt();
 }
+
+/// What node 0's host hears back within `wait` when it sends a DL frame
+/// on `plm sim --nodes 2 <args>` (node 1 echoes what it hears): the
+/// indication's frame, if any.
+fn echo_heard(args: &[&str], wait: Duration) -> Option<LocalFrame> {
+    use plm_core::st7580::{Command as Cmd, DataRequest, TxParams};
+    let mut server = Server::start(&[&["--nodes", "2", "--listen", "127.0.0.1:0"], args].concat());
+    let mut c = Client::connect(&server.addr);
+    server.line_containing("connected");
+    c.send(&[IAC, WILL, COM_PORT]);
+    c.expect_telnet("DO COM-PORT-OPTION", |t| {
+        *t == Telnet::Negotiation(DO, COM_PORT)
+    });
+    c.set_rts(false);
+    assert_eq!(c.next_frame().code, 0x3E, "BIO_ResetIndication");
+    let request = Cmd::DlDataRequest(DataRequest {
+        params: TxParams::default(),
+        payload: b"echo me".to_vec(),
+    })
+    .to_frame()
+    .emit(Dialect::St7580)
+    .unwrap();
+    assert_eq!(ask(&mut c, &request).code, 0x51, "DL_DataConfirm");
+    let until = Instant::now() + wait;
+    let mut heard = None;
+    while Instant::now() < until && heard.is_none() {
+        c.pump();
+        while let Some(e) = c.elements.pop_front() {
+            if let Element::Frame { frame, .. } = e {
+                c.send_data(&[0x06]);
+                if frame.code == 0x52 {
+                    heard = Some(frame);
+                }
+            }
+        }
+    }
+    drop(c);
+    server.line_containing("disconnected");
+    server.interrupt();
+    heard
+}
+
+#[test]
+fn loss_applies_to_a_line_of_modems() {
+    let echo = echo_heard(&[], WAIT).expect("the echo on a line without loss");
+    assert!(echo.data.ends_with(b"echo me"), "{echo:?}");
+    // Each frame lost at each receiver 99 times in 100: the frame or its
+    // echo is lost (both cross 1 time in 10 000).
+    assert_eq!(
+        echo_heard(&["--loss", "0.99"], Duration::from_secs(2)),
+        None
+    );
+}
