@@ -17,6 +17,7 @@
 mod common;
 
 use common::{com_port, escape, Link, Server, Telnet, RTS_OFF, RTS_ON, SET_CONTROL};
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Hid, LampState};
 use plm_core::app::service::{Discovered, Service};
 use plm_core::app::{
@@ -167,8 +168,8 @@ impl Driver {
     }
 
     /// Discovery in rounds, each reply acknowledged as it comes.
-    fn discover(&mut self, session: u8, window: u8, max_rounds: u8) -> (Discovery, usize) {
-        let (mut d, first) = Discovery::start(self.now(), session, window, max_rounds);
+    fn discover(&mut self, config: DiscoveryConfig) -> (Discovery, usize) {
+        let (mut d, first) = Discovery::start(self.now(), config);
         self.conc.submit(self.now(), first);
         self.flush();
         let mut replies = 0;
@@ -180,8 +181,8 @@ impl Driver {
                     address, message, ..
                 }) = h
                 {
+                    replies += 1;
                     if let Some(ack) = d.on_message(address, &message) {
-                        replies += 1;
                         self.conc.send(self.now(), ack);
                         self.flush();
                     }
@@ -219,27 +220,26 @@ fn concentrator_board_over_rfc2217_discovers_reads_and_dims_a_street() {
     server.line_containing("connected");
     let mut d = Driver::new(link, Concentrator::usart(RequesterConfig::default()));
 
-    // 1. Discovery: every lamp answers once per session, is acknowledged,
-    // and nothing but the street's lamps answers.
-    let (discovery, replies) = d.discover(1, Discovery::window_for(5), 6);
+    // 1. Discovery: every lamp answers, is named in the next frame's
+    // request, and nothing but the street's lamps answers.
+    let (discovery, replies) = d.discover(DiscoveryConfig::new(1, 5));
     let found: BTreeMap<Address, Discovered> = discovery.found().iter().copied().collect();
     let lamps: Vec<Address> = (1..=5).map(street_address).collect();
     assert_eq!(
         found.keys().copied().collect::<Vec<_>>(),
         lamps,
-        "found after {} round(s)",
-        discovery.round()
+        "found after {} frame(s)",
+        discovery.frames()
     );
     for (a, info) in found {
         assert_eq!(info.firmware, FIRMWARE, "{a}: firmware release");
     }
-    // Acknowledged lamps keep quiet for the rest of the session: only a
-    // lamp whose reply or acknowledgement was lost on the line answers
-    // again, once per later round.
+    // Named lamps keep quiet for the rest of the session: only a lamp
+    // that missed the request naming it answers again.
     assert!(
-        replies <= 5 * discovery.round() as usize,
-        "{replies} replies in {} round(s)",
-        discovery.round()
+        replies <= 5 + discovery.frames() as usize,
+        "{replies} replies in {} frame(s)",
+        discovery.frames()
     );
 
     // 2. All parameters of lamp 2: burning, drawing power.

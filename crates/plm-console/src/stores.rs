@@ -138,7 +138,7 @@ pub struct StreetStore {
     /// The discovery round running, if any (a u64, not the round's u8:
     /// a signal type of its own would bring its own copy of the signal
     /// code, docs/console.md "Size").
-    pub discovering: RwSignal<Option<u64>>,
+    pub discovering: RwSignal<Option<(usize, usize)>>,
     /// What the street is reached through, in words.
     pub port: RwSignal<String>,
     /// Application frames sent to the street so far.
@@ -698,7 +698,7 @@ impl Console {
         let (sweep, discovering, now) = {
             let session = self.street.session();
             let s = session.borrow();
-            (s.sweep(), s.discovering().map(u64::from), s.now())
+            (s.sweep(), s.discovering(), s.now())
         };
         let street = self.street;
         set_if_changed(street.sweep, sweep);

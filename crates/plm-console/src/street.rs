@@ -12,6 +12,7 @@ pub use campaign::Campaign;
 
 use crate::session::{Budget, Pacer};
 use crate::transport::{LinkState, Transport};
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Hid, LampState};
 use plm_core::app::service::{Clock, Discovered, Service};
 use plm_core::app::{
@@ -222,9 +223,12 @@ impl StreetSession {
         self.sweep
     }
 
-    /// Whether a discovery is running, and its round.
-    pub fn discovering(&self) -> Option<u8> {
-        self.discovery.as_ref().map(|d| d.round())
+    /// Whether a discovery is running: the boards found so far and how
+    /// many it believes are left.
+    pub fn discovering(&self) -> Option<(usize, usize)> {
+        self.discovery
+            .as_ref()
+            .map(|d| (d.found().len(), (d.left() + 0.5) as usize))
     }
 
     /// Requests not yet answered.
@@ -237,8 +241,7 @@ impl StreetSession {
         let now = self.now();
         self.session_no = self.session_no.wrapping_add(1);
         let expected = self.fleet.len().max(12);
-        let (d, first) =
-            Discovery::start(now, self.session_no, Discovery::window_for(expected), 40);
+        let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, expected));
         self.discovery = Some(d);
         self.conc.submit(now, first);
         self.flush();
@@ -479,13 +482,13 @@ impl StreetSession {
                 if let Some(d) = self.discovery.as_mut() {
                     if let Some(ack) = d.on_message(address, &message) {
                         self.conc.send(now, ack);
-                        if let Message::Service(Service::DiscoverReply(r)) = message {
-                            let lamp = self.lamp(address);
-                            lamp.discovered = Some(r);
-                            lamp.snr = lamp.snr.or(Some(r.snr as i8));
-                            lamp.last_seen = Some(now);
-                            self.out.changed = true;
-                        }
+                    }
+                    if let Message::Service(Service::DiscoverReply(r)) = message {
+                        let lamp = self.lamp(address);
+                        lamp.discovered = Some(r);
+                        lamp.snr = lamp.snr.or(Some(r.snr as i8));
+                        lamp.last_seen = Some(now);
+                        self.out.changed = true;
                     }
                 }
             }

@@ -19,9 +19,10 @@
 //!    against the same engine lamp by lamp (ratio: how many times
 //!    faster), in simulated seconds.
 
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Hid};
 use plm_core::app::service::{Discovered, Release, Service};
-use plm_core::app::{Discovery, LineFrame, Message, RequesterConfig};
+use plm_core::app::{LineFrame, Message, RequesterConfig};
 use plm_core::st7580::mib::{index, object, PhyConfig};
 use plm_core::st7580::{Modulation, TxParams};
 use plm_core::time::{Duration, MS};
@@ -164,15 +165,14 @@ fn discover_and_read(lamps: usize) {
     let mut d = street(lamps);
     let start = d.now();
     let wall = Instant::now();
-    let window = Discovery::window_for(lamps);
-    let found = d.discover(1, window, 12);
+    let found = d.discover(DiscoveryConfig::new(1, lamps));
     let discovered = d.now() - start;
     let (replies, failed) = read_all(&mut d, lamps, 1);
     let took = (d.now() - start) as f64 / 1e6;
     let wall = wall.elapsed().as_secs_f64();
 
     // The frames that must cross the line.
-    let discover = Message::Service(Service::Discover { session: 1, window });
+    let discover = Message::Service(Service::DiscoverAny);
     let reply = Message::Service(Service::DiscoverReply(Discovered {
         firmware: FIRMWARE,
         stack: STACK,
@@ -195,7 +195,7 @@ fn discover_and_read(lamps: usize) {
     let limit = limit as f64 / 1e6;
     println!(
         "street discover+read {lamps} lamps: {took:.1} s simulated, channel limit {limit:.1} s, \
-         ratio {:.2} (discovery {:.1} s, window {window} s, {} of {lamps} found; \
+         ratio {:.2} (discovery {:.1} s, {} of {lamps} found; \
          {} read, {failed} failed; {wall:.2} s wall)",
         limit / took,
         discovered as f64 / 1e6,
@@ -263,6 +263,10 @@ fn update(lamps: usize, size: usize) {
 }
 
 fn main() {
+    if let Ok(n) = std::env::var("LAMPS") {
+        discover_and_read(n.parse().expect("LAMPS: a number"));
+        return;
+    }
     discover_and_read(100);
     sweep(500, 5);
     update_one(Modulation::BPskCoded);

@@ -20,6 +20,7 @@ use crate::breach::Breach;
 use crate::rfu::{self, RfuManager};
 use crate::rng::Rng;
 use plm_core::app::concentrator::USART_IDLE;
+use plm_core::app::discovery::Responder;
 use plm_core::app::hid::{self, Hid};
 use plm_core::app::service::{Discovered, Release, Service, PARAM_LEN, SNR_MAX};
 use plm_core::app::{
@@ -109,6 +110,11 @@ pub struct Board {
     discovery_session: Option<u8>,
     discovery_acked: Option<u8>,
     discovery_reply: Option<(Instant, Address)>,
+    /// Discovery rule 2: quiet once named in a session.
+    responder: Responder,
+    /// Broadcasts it could not read: left unanswered (hundreds of error
+    /// frames at once would jam the line), counted here.
+    pub unread_broadcasts: u64,
     mib_asks: VecDeque<MibAsk>,
     /// Answers from the ballast on their way: when, to whom, what.
     hid_answers: VecDeque<(Instant, Address, Message)>,
@@ -153,6 +159,8 @@ impl Board {
             discovery_session: None,
             discovery_acked: None,
             discovery_reply: None,
+            responder: Responder::default(),
+            unread_broadcasts: 0,
             mib_asks: VecDeque::new(),
             hid_answers: VecDeque::new(),
             usart: None,
@@ -191,6 +199,7 @@ impl Board {
         self.discovery_session = None;
         self.discovery_acked = None;
         self.discovery_reply = None;
+        self.responder = Responder::default();
         self.mib_asks.clear();
         self.hid_answers.clear();
         self.line_out.clear();
@@ -432,6 +441,10 @@ impl Board {
     ) -> Option<Message> {
         let m = match Message::of(frame) {
             Ok(m) => m,
+            Err(_) if broadcast => {
+                self.unread_broadcasts += 1;
+                return None;
+            }
             Err(_) if frame.frame_type == FrameType::Service => {
                 return Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR))
             }
@@ -556,6 +569,12 @@ impl Board {
                 ack
             }
             Service::IoConfigGet => reply(Service::IoConfig(self.io_config)),
+            Service::DiscoverAny | Service::DiscoverFrame(_) => {
+                if let Some(after) = self.responder.on_request(&self.address, s) {
+                    self.discovery_reply = Some((now + after, from));
+                }
+                None
+            }
             Service::Discover { session, window } => {
                 self.discovery_session = Some(*session);
                 if self.discovery_acked != Some(*session) {

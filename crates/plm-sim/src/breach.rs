@@ -59,7 +59,9 @@ impl Breach {
             (Breach::Release, Message::Service(Service::FwRelGet))
                 | (
                     Breach::Discovery,
-                    Message::Service(Service::Discover { .. })
+                    Message::Service(
+                        Service::Discover { .. } | Service::DiscoverAny | Service::DiscoverFrame(_)
+                    )
                 )
                 | (
                     Breach::DiscoveryAck,

@@ -189,14 +189,13 @@ impl StreetDriver {
         }
     }
 
-    /// Discovers the boards on the line in rounds; returns what was found.
+    /// Discovers the boards on the line (plm-core's rule); returns what
+    /// was found.
     pub fn discover(
         &mut self,
-        session: u8,
-        window: u8,
-        max_rounds: u8,
+        config: plm_core::app::discovery::DiscoveryConfig,
     ) -> BTreeMap<Address, plm_core::app::Discovered> {
-        let (mut d, first) = Discovery::start(self.sim.now(), session, window, max_rounds);
+        let (mut d, first) = Discovery::start(self.sim.now(), config);
         self.submit(first);
         while !d.is_done() {
             let until = d.poll_timeout().unwrap_or(self.sim.now());

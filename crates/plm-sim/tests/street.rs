@@ -40,7 +40,7 @@ fn journey(via: Attach) {
     let mut d = street(lamps, via, 7);
 
     // Discover every board.
-    let found = d.discover(1, plm_core::app::Discovery::window_for(lamps), 12);
+    let found = d.discover(plm_core::app::discovery::DiscoveryConfig::new(1, lamps));
     let missing: Vec<usize> = (1..=lamps)
         .filter(|n| !found.contains_key(&street_address(*n)))
         .collect();

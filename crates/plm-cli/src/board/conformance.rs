@@ -11,7 +11,7 @@ mod rfu;
 
 use super::driver::Driver;
 use super::{exit, session, Failure};
-use plm_core::app::discovery::ROUND_MARGIN;
+use plm_core::app::discovery::rounds::ROUND_MARGIN;
 use plm_core::app::rfu::{Status, REASONS, STATES};
 use plm_core::app::update::UpdateConfig;
 use plm_core::app::{Address, AppEvent, ErrorCode, Happening, Message, Release, Request, Service};

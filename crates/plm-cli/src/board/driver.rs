@@ -8,6 +8,7 @@
 
 use super::Failure;
 use crate::port::Port;
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Message, Request,
     RequestId,
@@ -162,17 +163,14 @@ impl Driver {
         })
     }
 
-    /// Discovery in rounds (`session`, first `window` s, at most
-    /// `rounds`): each answer is acknowledged as it comes and handed to
-    /// `found` the first time a board is heard.
+    /// Discovery (plm-core's rule): each board is handed to `found` the
+    /// first time it is heard.
     pub fn discover(
         &mut self,
-        session: u8,
-        window: u8,
-        rounds: u8,
+        config: DiscoveryConfig,
         mut found: impl FnMut(Address, Discovered),
     ) -> Result<Discovery, Failure> {
-        let (mut d, first) = Discovery::start(self.now(), session, window, rounds);
+        let (mut d, first) = Discovery::start(self.now(), config);
         self.submit(first)?;
         while !d.is_done() {
             for h in self.step(d.poll_timeout())? {

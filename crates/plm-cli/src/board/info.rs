@@ -2,19 +2,21 @@
 //! in words, or JSON lines with `--json`.
 
 use super::driver::Driver;
-use super::{exit, session, Failure, Target};
+use super::{exit, Failure, Target};
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Ballast, Hid};
 use plm_core::app::{Address, AppEvent, Message, Request, Service};
 use serde_json::{json, Map, Value};
 
 /// Discovers the boards; prints each as it is found.
-pub fn discover(d: &mut Driver, window: u8, rounds: u8, json: bool) -> Result<u8, Failure> {
+pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
     tell!(
-        "plm board: discovering (first window {window} s; the line is quiet for a round \
-         before it ends)"
+        "plm board: discovering (about {} boards expected; it ends when the line has been \
+         quiet long enough to be sure)",
+        config.guess
     );
     let started = std::time::Instant::now();
-    let found = d.discover(session(), window, rounds, |address, info| {
+    let found = d.discover(config, |address, info| {
         if json {
             say!(
                 "{}",
@@ -35,19 +37,19 @@ pub fn discover(d: &mut Driver, window: u8, rounds: u8, json: bool) -> Result<u8
         }
     })?;
     let n = found.found().len();
-    let secs = started.elapsed().as_secs();
+    let secs = started.elapsed().as_secs_f64();
     if n == 0 {
         tell!(
-            "plm board: no board answered in {} round(s), {secs} s: are the boards powered, \
+            "plm board: no board answered in {} frame(s), {secs:.1} s: are the boards powered, \
              and is the port the concentrator's (--via)?",
-            found.round()
+            found.frames()
         );
         return Ok(exit::FAILED);
     }
     tell!(
-        "plm board: {n} board{} found in {} round(s), {secs} s",
+        "plm board: {n} board{} found in {} frame(s), {secs:.1} s",
         if n == 1 { "" } else { "s" },
-        found.round()
+        found.frames()
     );
     Ok(exit::OK)
 }

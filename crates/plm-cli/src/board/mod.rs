@@ -33,6 +33,7 @@ mod rfu;
 use crate::port;
 use clap::{Args, Subcommand, ValueEnum};
 use driver::Driver;
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::{Address, Concentrator, Release, RequesterConfig};
 use plm_core::st7580::TxParams;
 use std::path::PathBuf;
@@ -151,13 +152,14 @@ pub enum BoardCommand {
     /// Find the boards on the line (SERVICE_NET_DISCOVER_REQ in rounds
     /// until the line is quiet); one line per board found.
     Discover {
-        /// First reply window, seconds (1-60): about 1 s per 10 boards
-        /// expected. It widens by itself when the line is crowded.
-        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=60))]
-        window: u8,
-        /// At most this many rounds.
-        #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u8).range(1..))]
-        rounds: u8,
+        /// How many boards you expect (half or twice the truth costs a
+        /// few frames, never a board).
+        #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..=4095))]
+        guess: u16,
+        /// Also look, after the slotted frames, for boards on the older
+        /// discovery rule (rounds and ACKs): about 1.5 s more.
+        #[arg(long)]
+        older_rule: bool,
     },
     /// Read what a board offers: firmware release, lamp (HID ballast),
     /// clock, GPIO, SNR.
@@ -276,9 +278,11 @@ pub fn run(args: BoardArgs) -> u8 {
 
 fn dispatch(args: BoardArgs) -> Result<u8, Failure> {
     match &args.command {
-        BoardCommand::Discover { window, rounds } => {
+        BoardCommand::Discover { guess, older_rule } => {
             let mut d = connect(&args)?;
-            info::discover(&mut d, *window, *rounds, args.json)
+            let mut config = DiscoveryConfig::new(session(), *guess as usize);
+            config.older_rule = *older_rule;
+            info::discover(&mut d, config, args.json)
         }
         BoardCommand::Status { node } => {
             let mut d = connect(&args)?;

@@ -6,6 +6,7 @@
 use super::driver::{interrupted, Driver};
 use super::{connect, exit, session, BoardArgs, Failure, ImageArgs, RfuArgs};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::rfu::{self, image};
 use plm_core::app::update::{BoardState, Update, UpdateConfig};
 use plm_core::app::{Address, AppEvent, Happening, RequestId};
@@ -266,7 +267,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
 /// `--all`: the boards a discovery finds.
 fn find_boards(d: &mut Driver) -> Result<Vec<Address>, Failure> {
     tell!("plm board: discovering the boards to update");
-    let found = d.discover(session(), 2, 40, |a, info| {
+    let found = d.discover(DiscoveryConfig::new(session(), 12), |a, info| {
         tell!("plm board: found {a} (firmware {})", info.firmware);
     })?;
     Ok(found.found().iter().map(|(a, _)| *a).collect())

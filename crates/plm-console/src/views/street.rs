@@ -197,7 +197,7 @@ fn SweepControl() -> impl IntoView {
         </label>
         <span id="street-progress" class="muted">
             {move || match (street.discovering.get(), street.sweep.get()) {
-                (Some(round), _) => format!("discovering (round {round})…"),
+                (Some((found, left)), _) => format!("discovering: {found} found, about {left} left…"),
                 (None, s) if s.on && s.total > 0 => format!("reading {}/{} (sweep {})", s.done, s.total, s.rounds + 1),
                 (None, s) if s.on => format!(
                     "{} sweep{} done; next in a few seconds",

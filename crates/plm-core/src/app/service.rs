@@ -8,6 +8,7 @@
 //! frame is read without knowing which way it went.
 
 use super::error::ErrorCode;
+use super::frame::Address;
 use super::rfu::{self, fields as rf};
 use crate::field::{self, Field, FieldError};
 use alloc::vec::Vec;
@@ -102,6 +103,25 @@ pub mod fields {
     pub const WINDOW: Field = Field::uint("window", "Reply window", 1, 1)
         .range(1, 60)
         .unit("s");
+    /// Discovery rule of a slotted frame (docs/protocol-notes.md,
+    /// "Discovery"); rule 1 requests carry no rule byte.
+    pub const RULE: Field = Field::uint("rule", "Discovery rule", 0, 1).range(2, 2);
+    /// Slotted frame: the session.
+    pub const FRAME_SESSION: Field = Field::uint("session", "Discovery session", 1, 1);
+    /// Slotted frame: its number in the session.
+    pub const FRAME: Field = Field::uint("frame", "Frame number", 2, 1);
+    /// Slotted frame: reply slots.
+    pub const SLOTS: Field = Field::uint("slots", "Reply slots", 3, 1).range(1, 255);
+    /// Slotted frame: length of one slot.
+    pub const SLOT_MS: Field = Field::uint("slot_ms", "Slot length", 4, 1)
+        .range(1, 255)
+        .unit("ms");
+    /// Slotted frame: a board answers when its draw (0-255) is at most
+    /// this (255: every board).
+    pub const SHARE: Field = Field::uint("share", "Share that answers", 5, 1);
+    /// Slotted frame: the addresses heard in the previous frame, 6 bytes
+    /// each, which stay quiet for the rest of the session.
+    pub const HEARD: Field = Field::bytes("heard", "Addresses heard", 6, 0);
     /// Discovery reply: SNR at which the board heard the request.
     pub const DISCOVERY_SNR: Field = Field::uint("snr", "SNR of the request", 4, 1)
         .range(0, SNR_MAX as i64)
@@ -117,8 +137,11 @@ pub mod fields {
     pub const RELEASES: &[Field] = &[FIRMWARE_MAJOR, FIRMWARE_MINOR, STACK_MAJOR, STACK_MINOR];
     /// CLOCK_SET request, CLOCK_GET reply.
     pub const CLOCK: &[Field] = &[HOURS, MINUTES, SECONDS];
-    /// NET_DISCOVER_REQ request.
+    /// NET_DISCOVER_REQ request, rule 1 (rounds).
     pub const DISCOVER: &[Field] = &[SESSION, WINDOW];
+    /// NET_DISCOVER_REQ request, rule 2 (slotted frames).
+    pub const DISCOVER_FRAME: &[Field] =
+        &[RULE, FRAME_SESSION, FRAME, SLOTS, SLOT_MS, SHARE, HEARD];
     /// NET_DISCOVER_REQ reply.
     pub const DISCOVERED: &[Field] = &[
         FIRMWARE_MAJOR,
@@ -373,6 +396,60 @@ pub struct Discovered {
     pub snr: u8,
 }
 
+/// A discovery request of rule 2: one frame of reply slots
+/// (docs/protocol-notes.md, "Discovery").
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SlotFrame {
+    /// Session: a board heard in it stays quiet until the next.
+    pub session: u8,
+    /// Frame number in the session (a board's slot changes with it).
+    pub frame: u8,
+    /// Reply slots (1-255).
+    pub slots: u8,
+    /// Length of one slot, ms.
+    pub slot_ms: u8,
+    /// A board answers when its draw is at most this (255: all).
+    pub share: u8,
+    /// Addresses heard in the previous frame (at most
+    /// [`SlotFrame::MAX_HEARD`]).
+    pub heard: Vec<Address>,
+}
+
+impl SlotFrame {
+    /// The rule byte a slotted frame starts with.
+    pub const RULE: u8 = 2;
+    /// Data bytes before the heard addresses.
+    pub const FIXED: usize = 6;
+    /// Addresses one request carries (the frame's 100-byte payload).
+    pub const MAX_HEARD: usize = 15;
+    /// What a bare 0Bh (no data, as seed 004 lists it) stands for.
+    pub const BARE: SlotFrame = SlotFrame {
+        session: 0,
+        frame: 0,
+        slots: 16,
+        slot_ms: 40,
+        share: 255,
+        heard: Vec::new(),
+    };
+
+    fn parse(d: &[u8]) -> Option<SlotFrame> {
+        let (fixed, heard) = d.split_at_checked(Self::FIXED)?;
+        let ok =
+            fixed[0] == Self::RULE && heard.len() % 6 == 0 && heard.len() / 6 <= Self::MAX_HEARD;
+        ok.then(|| SlotFrame {
+            session: fixed[1],
+            frame: fixed[2],
+            slots: fixed[3],
+            slot_ms: fixed[4],
+            share: fixed[5],
+            heard: heard
+                .chunks_exact(6)
+                .map(|c| Address(c.try_into().expect("6 bytes")))
+                .collect(),
+        })
+    }
+}
+
 /// A service frame's payload, typed: requests and their replies.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum Service {
@@ -426,7 +503,10 @@ pub enum Service {
     IoConfigGet,
     /// 0Ah reply.
     IoConfig(u8),
-    /// 0Bh request.
+    /// 0Bh request with no data, as seed 004 lists it: answered as a
+    /// slotted frame with the defaults ([`SlotFrame::BARE`]).
+    DiscoverAny,
+    /// 0Bh request, rule 1 (the older rule: rounds and ACKs).
     Discover {
         /// Session number: a board acknowledged in a session answers no
         /// more requests of it.
@@ -434,6 +514,8 @@ pub enum Service {
         /// Reply window, s.
         window: u8,
     },
+    /// 0Bh request, rule 2: a frame of reply slots.
+    DiscoverFrame(SlotFrame),
     /// 0Bh reply.
     DiscoverReply(Discovered),
     /// 0Fh.
@@ -569,6 +651,23 @@ impl Service {
             Answer::Reply(_, n) => Some(n),
             _ => None,
         };
+        if command == 0x0b && reply_len != Some(d.len()) {
+            return match d.len() {
+                0 => Ok(Service::DiscoverAny),
+                2 => Ok(Service::Discover {
+                    session: get(&f::SESSION, d),
+                    window: get(&f::WINDOW, d),
+                }),
+                _ => SlotFrame::parse(d)
+                    .map(Service::DiscoverFrame)
+                    .ok_or(ServiceError::Length {
+                        name: desc.name,
+                        request: SlotFrame::FIXED,
+                        reply: reply_len,
+                        got: d.len(),
+                    }),
+            };
+        }
         let is_request = desc.request_len.is_none_or(|n| n == d.len());
         let is_reply = reply_len == Some(d.len());
         if !is_request && !is_reply {
@@ -670,7 +769,7 @@ impl Service {
             ClockGet | ClockNow(_) => 0x08,
             IoConfigSet(_) => 0x09,
             IoConfigGet | IoConfig(_) => 0x0a,
-            Discover { .. } | DiscoverReply(_) => 0x0b,
+            DiscoverAny | Discover { .. } | DiscoverFrame(_) | DiscoverReply(_) => 0x0b,
             SnSet(_) => 0x0f,
             SnGet | Sn(_) => 0x10,
             RfuHeader(_) => 0x0c,
@@ -709,7 +808,7 @@ impl Service {
         let mut out = alloc::vec![self.command()];
         match self {
             SoftwareReset | HardwareReset | InputsGet | FwRelGet | ClockGet | IoConfigGet
-            | SnGet => {}
+            | SnGet | DiscoverAny => {}
             ParamSet { group, data } | Params { group, data } => {
                 out.push(*group);
                 out.extend_from_slice(data);
@@ -723,6 +822,19 @@ impl Service {
             }
             ClockSet(c) | ClockNow(c) => out.extend_from_slice(&[c.hours, c.minutes, c.seconds]),
             Discover { session, window } => out.extend_from_slice(&[*session, *window]),
+            DiscoverFrame(fr) => {
+                out.extend_from_slice(&[
+                    SlotFrame::RULE,
+                    fr.session,
+                    fr.frame,
+                    fr.slots,
+                    fr.slot_ms,
+                    fr.share,
+                ]);
+                for a in &fr.heard {
+                    out.extend_from_slice(&a.0);
+                }
+            }
             DiscoverReply(r) => out.extend_from_slice(&[
                 r.firmware.major,
                 r.firmware.minor,
@@ -763,6 +875,11 @@ impl Service {
 
     /// The data layout of this request or reply.
     pub fn layout(&self) -> &'static [Field] {
+        match self {
+            Service::DiscoverAny => return &[],
+            Service::DiscoverFrame(_) => return f::DISCOVER_FRAME,
+            _ => {}
+        }
         match (self.desc(), self.is_request()) {
             (Some(d), true) => d.request,
             (
@@ -783,7 +900,11 @@ impl Service {
         let payload = self.payload();
         let data = &payload[1..];
         if let Some(desc) = self.desc() {
-            let want = if self.is_request() {
+            let want = if let Service::DiscoverFrame(fr) = self {
+                Some(SlotFrame::FIXED + 6 * fr.heard.len().min(SlotFrame::MAX_HEARD))
+            } else if matches!(self, Service::DiscoverAny) {
+                Some(0)
+            } else if self.is_request() {
                 desc.request_len
             } else if let Answer::Reply(_, n) = desc.answer {
                 Some(n)

@@ -1,6 +1,5 @@
-//! Network discovery (SERVICE_NET_DISCOVER_REQ, 0Bh), in rounds. The
-//! seed names the command only; the procedure is decided here
-//! (docs/protocol-notes.md, "Discovery"):
+//! Discovery rule 1, the older rule: rounds and ACKs. Kept so that a
+//! board still on it is found (docs/protocol-notes.md, "Discovery"):
 //!
 //! 1. the concentrator broadcasts `[session, window]`;
 //! 2. every board not yet acknowledged in that session answers once, at a
@@ -9,15 +8,15 @@
 //!    `[01h, 0Bh]`: that board stays quiet for the rest of the session;
 //! 4. after the window, a round that heard any answer is followed by
 //!    another (the answers that collided, and the boards whose ACK was
-//!    lost, come again); [`Discovery::next_window`] sizes it and says
+//!    lost, come again); [`Rounds::next_window`] sizes it and says
 //!    when silence means the street has answered.
 //!
 //! Sans-IO: the caller sends the requests and frames it is given.
 
-use super::frame::{Address, AppFrame};
-use super::message::Message;
-use super::requester::Request;
-use super::service::{Discovered, Service};
+use super::super::frame::{Address, AppFrame};
+use super::super::message::Message;
+use super::super::requester::Request;
+use super::super::service::{Discovered, Service};
 use crate::time::{Duration, Instant, MS};
 use alloc::vec::Vec;
 
@@ -29,9 +28,9 @@ pub const BOARDS_PER_SECOND: usize = 10;
 /// answer and its ACK take about 0.1 s on the line at B-PSK).
 pub const ROUND_MARGIN: Duration = 1_000 * MS;
 
-/// A discovery in progress.
+/// A rule-1 discovery in progress.
 #[derive(Debug, Clone)]
-pub struct Discovery {
+pub struct Rounds {
     session: u8,
     window: u8,
     max_rounds: u8,
@@ -53,12 +52,12 @@ pub struct Discovery {
     done: bool,
 }
 
-impl Discovery {
+impl Rounds {
     /// Starts a discovery now; returns it and the broadcast to send.
     /// `window` is in seconds (1-60): about 0.1 s per board expected
     /// keeps collisions rare.
-    pub fn start(now: Instant, session: u8, window: u8, max_rounds: u8) -> (Discovery, Request) {
-        let mut d = Discovery {
+    pub fn start(now: Instant, session: u8, window: u8, max_rounds: u8) -> (Rounds, Request) {
+        let mut d = Rounds {
             session,
             window: window.clamp(1, 60),
             max_rounds: max_rounds.max(1),
@@ -145,7 +144,7 @@ impl Discovery {
         Some(message.ack().to(address))
     }
 
-    /// When [`Discovery::handle_timeout`] is due.
+    /// When [`Rounds::handle_timeout`] is due.
     pub fn poll_timeout(&self) -> Option<Instant> {
         (!self.done).then_some(self.round_ends)
     }
@@ -158,7 +157,7 @@ impl Discovery {
         }
         let holds = self.window as usize * BOARDS_PER_SECOND;
         let heard = self.found.len() - self.found_before;
-        let next = Discovery::next_window(
+        let next = Rounds::next_window(
             self.window,
             heard,
             self.previous,
@@ -201,48 +200,33 @@ mod tests {
     #[test]
     fn crowded_rounds_widen_and_silence_ends_only_after_a_quiet_round() {
         // 2 s hold 20 answers: 5 heard is a crowd, 4 is not.
-        assert_eq!(
-            Discovery::next_window(2, 5, None, false, true, false),
-            Some(4)
-        );
-        assert_eq!(
-            Discovery::next_window(2, 4, None, false, true, false),
-            Some(2)
-        );
+        assert_eq!(Rounds::next_window(2, 5, None, false, true, false), Some(4));
+        assert_eq!(Rounds::next_window(2, 4, None, false, true, false), Some(2));
         // Fewer than the round before in the same window: the crowd thins.
         assert_eq!(
-            Discovery::next_window(4, 3, Some(6), false, true, false),
+            Rounds::next_window(4, 3, Some(6), false, true, false),
             Some(4)
         );
         // As many or more: a crowd keeps the count flat.
         assert_eq!(
-            Discovery::next_window(4, 6, Some(6), false, true, false),
+            Rounds::next_window(4, 6, Some(6), false, true, false),
             Some(8)
         );
         // Silence after a quiet round: done; after a crowd, or before
         // anybody was heard: look again with a wider window.
+        assert_eq!(Rounds::next_window(8, 0, Some(3), false, true, true), None);
         assert_eq!(
-            Discovery::next_window(8, 0, Some(3), false, true, true),
-            None
-        );
-        assert_eq!(
-            Discovery::next_window(8, 0, Some(3), false, true, false),
+            Rounds::next_window(8, 0, Some(3), false, true, false),
             Some(16)
         );
+        assert_eq!(Rounds::next_window(8, 0, None, true, true, false), Some(16));
         assert_eq!(
-            Discovery::next_window(8, 0, None, true, true, false),
+            Rounds::next_window(8, 0, None, false, false, false),
             Some(16)
         );
+        assert_eq!(Rounds::next_window(60, 0, None, true, false, false), None);
         assert_eq!(
-            Discovery::next_window(8, 0, None, false, false, false),
-            Some(16)
-        );
-        assert_eq!(
-            Discovery::next_window(60, 0, None, true, false, false),
-            None
-        );
-        assert_eq!(
-            Discovery::next_window(60, 400, None, true, true, false),
+            Rounds::next_window(60, 400, None, true, true, false),
             Some(60)
         );
     }
