@@ -181,10 +181,10 @@ impl Driver {
                     let before = d.found().len();
                     if let Some(ack) = d.on_message(address, &message) {
                         self.send(ack)?;
-                        if d.found().len() > before {
-                            if let Some((a, info)) = d.found().last() {
-                                found(*a, *info);
-                            }
+                    }
+                    if d.found().len() > before {
+                        if let Some((a, info)) = d.found().last() {
+                            found(*a, *info);
                         }
                     }
                 }

@@ -50,7 +50,9 @@ pub struct Timing {
     pub sync: Duration,
     /// From a request handed to the carrier to its first bit on the
     /// line, and from the last reply's end to its arrival at the host
-    /// (serial links and firmware, each way).
+    /// (serial links and firmware, each way; measured on the simulated
+    /// street through a concentrator board: a reply in the last slot
+    /// arrives 15-30 ms before a frame of 2 × 30 ms ends).
     pub relay: Duration,
 }
 
@@ -69,7 +71,7 @@ impl Timing {
         Timing {
             line_byte: 8_000_000 / bps,
             sync: 72 * 1_000_000 / 9_600,
-            relay: 40 * MS,
+            relay: 30 * MS,
         }
     }
 

@@ -56,24 +56,26 @@ pub struct Estimate {
 
 impl Estimate {
     /// Before any frame: about `guess` boards (a bell of width `guess / 2`
-    /// around it, nine tenths of the belief), and any number up to
-    /// [`MOST`] (one tenth, spread evenly over the orders of magnitude):
+    /// around it, [`BELL`] of the belief), and any number up to 16 times
+    /// the guess (the rest, spread evenly over the orders of magnitude):
     /// a street far larger than guessed is still looked for, by frames
-    /// that only a few boards answer.
+    /// that only a few boards answer, and a belief that gathers at its
+    /// top grows (up to [`MOST`]).
     pub fn new(guess: usize) -> Estimate {
         let g = guess.max(1) as f64;
-        let bell: Vec<f64> = (0..=MOST)
+        let top = (16 * guess).clamp(64, MOST);
+        let bell: Vec<f64> = (0..=top)
             .map(|n| {
                 let x = 2.0 * (n as f64 - g) / g;
                 1.0 / (1.0 + x * x * x * x)
             })
             .collect();
         let bell_total: f64 = bell.iter().sum();
-        let wide_total: f64 = (0..=MOST).map(|n| 1.0 / (n as f64 + 1.0)).sum();
+        let wide_total: f64 = (0..=top).map(|n| 1.0 / (n as f64 + 1.0)).sum();
         let belief = bell
             .iter()
             .enumerate()
-            .map(|(n, b)| 0.9 * b / bell_total + 0.1 / (n as f64 + 1.0) / wide_total)
+            .map(|(n, b)| BELL * b / bell_total + (1.0 - BELL) / (n as f64 + 1.0) / wide_total)
             .collect();
         let mut e = Estimate { belief };
         e.normalise();
@@ -130,6 +132,14 @@ impl Estimate {
             // what was heard.
             self.belief = Estimate::new(new.max(1)).belief;
         }
+        // Gathered at its top: the street is larger than the belief
+        // holds; it grows, the new part as likely as its top.
+        let top = self.belief.len();
+        if top <= MOST && self.belief[top - top / 8..].iter().sum::<f64>() > 0.01 {
+            let edge = self.belief[top - 1];
+            self.belief.resize((2 * top).min(MOST + 1), edge);
+            self.normalise();
+        }
     }
 
     /// The next frame: the slots and share that find the most boards
@@ -172,6 +182,9 @@ impl Estimate {
 
 /// The largest street the belief holds.
 pub const MOST: usize = 4_095;
+
+/// The share of the first belief that is the bell around the guess.
+const BELL: f64 = 0.98;
 
 /// A chance below this is taken as none.
 const NEGLIGIBLE: f64 = 1e-15;
