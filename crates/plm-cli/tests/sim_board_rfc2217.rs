@@ -17,12 +17,12 @@
 mod common;
 
 use common::{com_port, escape, Link, Server, Telnet, RTS_OFF, RTS_ON, SET_CONTROL};
-use plm_core::app::discovery::DiscoveryConfig;
+use plm_core::app::discovery::{reply_slot, DiscoveryConfig};
 use plm_core::app::hid::{self, Hid, LampState};
-use plm_core::app::service::{Discovered, Service};
+use plm_core::app::service::{Discovered, Service, SlotFrame};
 use plm_core::app::{
-    Address, AppEvent, Ballast, Concentrator, Discovery, FrameType, Happening, Message, Request,
-    RequesterConfig,
+    Address, AppEvent, Ballast, Concentrator, Discovery, ErrorCode, FrameType, Happening, Message,
+    Request, RequesterConfig,
 };
 use plm_core::link::host::{Event, Transmit};
 use plm_core::st7580::TxParams;
@@ -128,6 +128,16 @@ impl Driver {
             }
         }
         false
+    }
+
+    /// Every happening of the next `time`.
+    fn listen(&mut self, time: Duration) -> Vec<Happening> {
+        let until = Instant::now() + time;
+        let mut heard = Vec::new();
+        while Instant::now() < until {
+            heard.extend(self.step());
+        }
+        heard
     }
 
     /// Sends a request and waits for its fate (answer, failure, or sent).
@@ -313,6 +323,127 @@ fn concentrator_board_over_rfc2217_discovers_reads_and_dims_a_street() {
         )),
         "{:?}",
         d.log
+    );
+
+    drop(d);
+    server.line_containing("disconnected");
+    server.interrupt();
+}
+
+/// SERVICE_NET_DISCOVER_REQ as seed 004 lists it (0Bh, no data), and
+/// malformed (0Bh with 3 data bytes, a rule-2 request cut short: neither
+/// rule's request nor a reply), through `plm sim --board` and its
+/// default street of 12 lamps (docs/protocol-notes.md, "Discovery"):
+///
+/// - broadcast malformed: no board answers (500 error frames at once
+///   would jam the line);
+/// - broadcast bare, twice: the lamps answer each time (no session, no
+///   silencing), each in the slot of `SlotFrame::BARE` its address
+///   draws: every lamp alone in its slot is heard, in the order of the
+///   slots, and of lamps that share a slot at most one (the line may
+///   capture the strongest);
+/// - unicast malformed: APP_ERROR_SERVICE_CMD_ERROR.
+///
+/// A bare 0Bh carries no session or frame number, so a lamp's slot is
+/// the same at every bare request: lamps that share one collide every
+/// time (on this street lamps 1, 2, 4 and 5 all draw slot 0).
+#[test]
+fn a_bare_discover_is_answered_in_slots_and_a_malformed_one_only_when_unicast() {
+    let lamps = 12;
+    let slot = |a: &Address| {
+        reply_slot(a, &SlotFrame::BARE)
+            .unwrap_or_else(|| panic!("{a} sits a bare 0Bh out: its share is all"))
+    };
+    let mut by_slot: BTreeMap<u8, Vec<Address>> = BTreeMap::new();
+    for a in (1..=lamps).map(street_address) {
+        by_slot.entry(slot(&a)).or_default().push(a);
+    }
+    let alone: Vec<Address> = by_slot
+        .values()
+        .filter(|group| group.len() == 1)
+        .map(|group| group[0])
+        .collect();
+    assert!(
+        alone.len() >= 3,
+        "too few lamps alone in a slot: {by_slot:?}"
+    );
+    let street = lamps.to_string();
+    let mut server = Server::start(&["--board", "--listen", "127.0.0.1:0", "--street", &street]);
+    let link = Link::connect(&server.addr);
+    server.line_containing("connected");
+    let mut d = Driver::new(link, Concentrator::usart(RequesterConfig::default()));
+    // The last bare slot ends 16 × 40 ms after the request; the relays
+    // and a late firmware add well under a second.
+    let listen = Duration::from_millis(2_500);
+    let malformed = Message::Service(Service::Raw {
+        command: 0x0b,
+        data: vec![2, 1, 0],
+    });
+
+    let sent = d.request(Request::all(malformed.clone()));
+    assert!(matches!(sent, AppEvent::Sent { .. }), "{sent:?}");
+    let heard: Vec<Happening> = d
+        .listen(listen)
+        .into_iter()
+        .filter(|h| matches!(h, Happening::App(_)))
+        .collect();
+    assert!(
+        heard.is_empty(),
+        "a malformed broadcast 0Bh was answered: {heard:?}"
+    );
+
+    for time in ["first", "second"] {
+        let sent = d.request(Request::all(Message::Service(Service::DiscoverAny)));
+        assert!(matches!(sent, AppEvent::Sent { .. }), "{sent:?}");
+        let mut heard = Vec::new();
+        for h in d.listen(listen) {
+            match h {
+                Happening::App(AppEvent::Unsolicited {
+                    address,
+                    message: Message::Service(Service::DiscoverReply(info)),
+                    ..
+                }) => {
+                    assert_eq!(info.firmware, FIRMWARE, "{address}: firmware release");
+                    heard.push(address);
+                }
+                Happening::App(other) => panic!("{time} bare 0Bh: {other:?}"),
+                _ => {}
+            }
+        }
+        let words = |v: &[Address]| v.iter().map(|a| a.to_string()).collect::<Vec<_>>();
+        println!(
+            "{time} bare 0Bh: {} of {lamps} lamps heard: {:?}; slots shared: {:?}",
+            heard.len(),
+            words(&heard),
+            by_slot
+                .iter()
+                .filter(|(_, group)| group.len() > 1)
+                .map(|(s, group)| (s, words(group)))
+                .collect::<Vec<_>>()
+        );
+        let in_order: Vec<Address> = by_slot
+            .values()
+            .filter_map(|group| group.iter().find(|a| heard.contains(a)).copied())
+            .collect();
+        assert_eq!(
+            heard, in_order,
+            "{time} bare 0Bh: heard, against one lamp of each slot in the order of the slots \
+             ({by_slot:?})"
+        );
+        for a in &alone {
+            assert!(
+                heard.contains(a),
+                "{time} bare 0Bh: {a}, alone in slot {}, not heard: {heard:?}",
+                slot(a)
+            );
+        }
+    }
+
+    let lamp = street_address(2);
+    assert_eq!(
+        d.ask(lamp, malformed),
+        Message::Error(ErrorCode::SERVICE_CMD_ERROR),
+        "a malformed unicast 0Bh"
     );
 
     drop(d);
