@@ -1,14 +1,17 @@
 //! `cargo xtask bench`, street part (docs/architecture.md,
 //! "Performance and size"):
 //!
-//! 1. Discovering and reading a street of 100 lamps through the
-//!    concentrator board's USART (`StreetDriver::discover`, then
+//! 1. Discovering and reading streets of 12, 100 and 500 lamps through
+//!    the concentrator board's USART (`StreetDriver::discover`, then
 //!    `Hid::Get(ALL)` for every lamp, one after another), in simulated
 //!    seconds, against the channel limit: the airtime, at the modulation
 //!    in use (B-PSK, factory PHY_Config), of every frame that must cross
 //!    the line — the discovery broadcast, each lamp's discovery reply and
 //!    its acknowledgement, each read request and its reply — back to
-//!    back, with nothing between them.
+//!    back, with nothing between them. Then the line time of discovery
+//!    and of discovery with the reads against the street's targets
+//!    (docs/architecture.md, "Performance and size") and against the
+//!    slotted-ALOHA bound.
 //! 2. Simulated seconds per wall second of a 500-lamp street while the
 //!    concentrator sweeps it (reads every 5th lamp, one after another, from
 //!    the nearest to the farthest: 100 reads), against real time, and the
@@ -19,7 +22,7 @@
 //!    against the same engine lamp by lamp (ratio: how many times
 //!    faster), in simulated seconds.
 
-use plm_core::app::discovery::DiscoveryConfig;
+use plm_core::app::discovery::{DiscoveryConfig, Timing};
 use plm_core::app::hid::{self, Hid};
 use plm_core::app::service::{Discovered, Release, Service};
 use plm_core::app::{LineFrame, Message, RequesterConfig};
@@ -159,6 +162,35 @@ fn update_one(modulation: Modulation) {
     );
 }
 
+/// A street's line-time targets, s (docs/architecture.md, "Performance
+/// and size"): discovery alone, and discovery with every lamp read.
+fn targets(lamps: usize) -> (Option<f64>, Option<f64>) {
+    match lamps {
+        12 => (None, Some(5.0)),
+        100 => (None, Some(18.3)),
+        500 => (Some(60.0), None),
+        _ => (None, None),
+    }
+}
+
+/// The slotted-ALOHA bound of discovering `lamps` boards, s: a
+/// concentrator that observes only success or nothing (an empty slot and
+/// a collision sound alike) finds at best 1/e board per slot, so it
+/// needs e × n slots of `Timing::BPSK.slot_ms()` (docs/protocol-notes.md,
+/// "Discovery").
+fn aloha_bound(lamps: usize) -> f64 {
+    std::f64::consts::E * lamps as f64 * f64::from(Timing::BPSK.slot_ms()) / 1e3
+}
+
+/// `took` s against a target: the share of it used, and whether it is met.
+fn against(took: f64, target: Option<f64>) -> String {
+    match target {
+        Some(t) if took < t => format!("{:.2} of the {t} s target, met", took / t),
+        Some(t) => format!("{:.2} of the {t} s target, NOT met", took / t),
+        None => String::from("no target"),
+    }
+}
+
 fn discover_and_read(lamps: usize) {
     assert_eq!(TxParams::default().modulation, Modulation::BPsk);
     let phy = PhyConfig::decode(object(index::PHY_CONFIG).expect("MIB 01h").default);
@@ -201,6 +233,31 @@ fn discover_and_read(lamps: usize) {
         discovered as f64 / 1e6,
         found.len(),
         replies.len(),
+    );
+
+    // Against the targets and the bound. Once the boards are known the
+    // reads need no contention: at best one broadcast request and every
+    // reply back to back.
+    let discovered = discovered as f64 / 1e6;
+    let (discovery_target, read_target) = targets(lamps);
+    let bound = aloha_bound(lamps);
+    let reads = (line_airtime(&phy, &get, true)
+        + replies
+            .first()
+            .map_or(0, |m| lamps as Duration * line_airtime(&phy, m, false)))
+        as f64
+        / 1e6;
+    println!(
+        "street of {lamps} lamps in line time: discovery {discovered:.1} s, {}; slotted-ALOHA \
+         bound {bound:.1} s (e × {lamps} slots of {} ms), ratio {:.2}. Discovery and reads \
+         {took:.1} s, {}; bound {:.1} s (discovery's, then one read request and every reply \
+         back to back, {reads:.1} s), ratio {:.2}",
+        against(discovered, discovery_target),
+        Timing::BPSK.slot_ms(),
+        bound / discovered,
+        against(took, read_target),
+        bound + reads,
+        (bound + reads) / took,
     );
 }
 
@@ -267,7 +324,9 @@ fn main() {
         discover_and_read(n.parse().expect("LAMPS: a number"));
         return;
     }
-    discover_and_read(100);
+    for lamps in [12, 100, 500] {
+        discover_and_read(lamps);
+    }
     sweep(500, 5);
     update_one(Modulation::BPskCoded);
     update_one(Modulation::EightPsk);
