@@ -52,7 +52,7 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
-            name: "street: discover and read 100 lamps, sweep 500, firmware update (native)",
+            name: "street: discover and read 12, 100 and 500 lamps, sweep 500, firmware update (native)",
             sources: &["crates/plm-sim/examples/bench_street.rs"],
             cmd: Cmd::new("cargo").args([
                 "run",
