@@ -299,14 +299,25 @@ impl Discovery {
 pub struct Responder {
     /// The session it was named (heard) in: quiet until another.
     quiet_in: Option<u8>,
+    /// Bare requests heard: the frame number of the next one's draw, so
+    /// that two boards that share a slot once do not share it each time.
+    bare: u8,
 }
 
 impl Responder {
     /// A discovery request heard (rule 2, or bare): how long after
     /// hearing it the board answers, or `None` for silence.
     pub fn on_request(&mut self, me: &Address, service: &Service) -> Option<Duration> {
+        let bare;
         let frame = match service {
-            Service::DiscoverAny => &SlotFrame::BARE,
+            Service::DiscoverAny => {
+                bare = SlotFrame {
+                    frame: self.bare,
+                    ..SlotFrame::BARE
+                };
+                self.bare = self.bare.wrapping_add(1);
+                &bare
+            }
             Service::DiscoverFrame(f) => f,
             _ => return None,
         };
