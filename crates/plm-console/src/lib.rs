@@ -33,5 +33,6 @@ pub mod app;
 pub mod bench_hook;
 pub mod campaign_store;
 pub mod stores;
+pub mod street_store;
 pub mod views;
 pub mod wake;

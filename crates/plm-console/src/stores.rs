@@ -6,6 +6,7 @@ use crate::profile::Profile;
 use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
 use crate::storage::load;
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
+use crate::street_store;
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
 use crate::transport::Transport;
@@ -150,6 +151,9 @@ pub struct StreetStore {
     pub selected: RwSignal<Vec<plm_core::app::Address>>,
     /// Bumped whenever the update campaign changed.
     pub campaign: RwSignal<u64>,
+    /// The connection the street is remembered for
+    /// ([`crate::street_store::connection`]); empty: none.
+    pub kept_as: RwSignal<String>,
 }
 
 impl StreetStore {
@@ -275,6 +279,7 @@ pub fn provide_console() -> Console {
             now: signal(0),
             selected: signal(Vec::new()),
             campaign: signal(0),
+            kept_as: signal(String::new()),
         },
         profile: signal(Profile::default()),
     };
@@ -344,6 +349,7 @@ impl Console {
     /// current profile; the other session lets go of its transport.
     pub fn connect_transport(&self, transport: Box<dyn Transport>) {
         let profile = self.profile.get_untracked();
+        let mut problem = None;
         if profile.is_street() {
             self.session()
                 .borrow_mut()
@@ -359,14 +365,35 @@ impl Console {
                 ),
             };
             self.street.port.set(transport.port());
+            let simulated = transport.kind() == "Simulated";
+            let id = street_store::connection(
+                profile.key(),
+                &transport.port(),
+                baud,
+                simulated.then_some(SIM_SEED),
+            );
             let mut street = StreetSession::new(transport, conc);
-            street.discover();
+            match street_store::recall(&id) {
+                Ok(Some(r)) => street.recall(r.session, r.lamps),
+                kept => {
+                    problem = kept.err();
+                    // Boards heard in a session stay quiet in it: a street
+                    // this browser does not know may have been found in
+                    // session 1 by another.
+                    if !simulated {
+                        street.set_session(street_store::fresh_session());
+                    }
+                    street.discover();
+                }
+            }
+            self.street.kept_as.set(id);
             *self.street.session().borrow_mut() = street;
             self.street.alerts.set(VecDeque::new());
             self.street.sent.set(0);
         } else {
             *self.street.session().borrow_mut() = StreetSession::idle();
             self.street.port.set(String::new());
+            self.street.kept_as.set(String::new());
             self.session()
                 .borrow_mut()
                 .replace_transport(Some(transport), profile.dialect());
@@ -377,7 +404,7 @@ impl Console {
         self.modem.network.update(|n| n.clear());
         self.conn.retries.set(0);
         self.conn.last_problem.set(None);
-        self.conn.advice.set(None);
+        self.conn.advice.set(problem);
         self.refresh();
         let wired = load(&self.resetn_key()).is_some();
         self.conn.resetn_on_dtr.set(false);
@@ -439,6 +466,7 @@ impl Console {
         self.session().borrow_mut().replace_transport(None, dialect);
         *self.street.session().borrow_mut() = StreetSession::idle();
         self.street.port.set(String::new());
+        self.street.kept_as.set(String::new());
         self.refresh();
     }
 
@@ -694,6 +722,7 @@ impl Console {
             traffic,
             sent,
             campaign,
+            found,
         } = tick;
         let (sweep, discovering, now) = {
             let session = self.street.session();
@@ -709,6 +738,15 @@ impl Console {
         }
         if sent > 0 {
             street.sent.update(|n| *n += sent);
+        }
+        if found {
+            let (session, lamps) = self.street.read(|s| s.remembered());
+            let r = street_store::Remembered { session, lamps };
+            street.kept_as.with_untracked(|id| {
+                if !id.is_empty() {
+                    street_store::save(id, &r)
+                }
+            });
         }
         if campaign {
             self.street.read(crate::campaign_store::save);

@@ -132,6 +132,9 @@ pub struct StreetTick {
     pub sent: u64,
     /// The update campaign changed (to save it, and to show it).
     pub campaign: bool,
+    /// The street found changed: a lamp heard, a new session, a new
+    /// release (to remember it, [`StreetSession::remembered`]).
+    pub found: bool,
 }
 
 /// The street session.
@@ -141,6 +144,9 @@ pub struct StreetSession {
     pacer: Pacer,
     discovery: Option<Discovery>,
     session_no: u8,
+    /// A street recalled: once its lamps are read, discovery looks for
+    /// new ones.
+    look_for_new: bool,
     sweep: Sweep,
     sweep_queue: VecDeque<Address>,
     next_sweep: Option<Instant>,
@@ -163,6 +169,7 @@ impl StreetSession {
             pacer: Pacer::default(),
             discovery: None,
             session_no: 0,
+            look_for_new: false,
             sweep: Sweep::default(),
             sweep_queue: VecDeque::new(),
             next_sweep: None,
@@ -240,11 +247,61 @@ impl StreetSession {
     pub fn discover(&mut self) {
         let now = self.now();
         self.session_no = self.session_no.wrapping_add(1);
+        self.look_for_new = false;
         let expected = self.fleet.len().max(12);
         let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, expected));
         self.discovery = Some(d);
+        self.out.found = true;
         self.conc.submit(now, first);
         self.flush();
+    }
+
+    /// Numbers the sessions of the discoveries to come from `last` on
+    /// (the next is `last + 1`).
+    pub fn set_session(&mut self, last: u8) {
+        self.session_no = last;
+    }
+
+    /// Starts from a street found earlier in discovery session `session`
+    /// ([`StreetSession::remembered`]): its lamps are in the fleet at
+    /// once and read at once; then a discovery of the same session looks
+    /// for new ones only (the boards heard in it stay quiet; one that
+    /// restarted answers and is heard again).
+    pub fn recall(&mut self, session: u8, known: Vec<(Address, Discovered)>) {
+        self.session_no = session;
+        for (a, d) in known {
+            let lamp = self.lamp(a);
+            lamp.discovered = Some(d);
+            lamp.snr = Some(d.snr as i8);
+        }
+        self.look_for_new = true;
+        self.out.changed = true;
+        self.set_sweep(true);
+    }
+
+    /// What to remember of the street: the discovery session its lamps
+    /// were heard in, and each lamp discovery heard with what it said.
+    pub fn remembered(&self) -> (u8, Vec<(Address, Discovered)>) {
+        let lamps = self
+            .fleet
+            .values()
+            .filter_map(|l| Some((l.address, l.discovered?)))
+            .collect();
+        (self.session_no, lamps)
+    }
+
+    /// Looks for boards not in the fleet, in the session its lamps were
+    /// heard in: one new board expected.
+    fn look_for_new(&mut self, now: Instant) {
+        self.look_for_new = false;
+        let (_, known) = self.remembered();
+        let config = DiscoveryConfig::new(self.session_no, 1);
+        let (d, first) = Discovery::resume(now, config, known);
+        self.discovery = Some(d);
+        self.out.changed = true;
+        // Remembered again: the connection was used last.
+        self.out.found = true;
+        self.conc.submit(now, first);
     }
 
     /// Turns the background sweep on or off.
@@ -431,6 +488,9 @@ impl StreetSession {
                 self.sweep.total = 0;
                 self.next_sweep = Some(now + SWEEP_PAUSE);
                 self.out.changed = true;
+                if self.look_for_new {
+                    self.look_for_new(now);
+                }
             }
         }
     }
@@ -489,6 +549,7 @@ impl StreetSession {
                         lamp.snr = lamp.snr.or(Some(r.snr as i8));
                         lamp.last_seen = Some(now);
                         self.out.changed = true;
+                        self.out.found = true;
                     }
                 }
             }
@@ -733,6 +794,67 @@ mod tests {
             assert!(s.fleet()[&street_address(5)].in_trouble());
             assert!(s.fleet()[&street_address(8)].in_trouble());
             assert!(!s.fleet()[&street_address(6)].in_trouble());
+        }
+    }
+
+    /// A street remembered after a reload: its lamps in the fleet at once
+    /// and read before any discovery frame; then a discovery of the same
+    /// session finds the lamp that was off before, while the lamps heard
+    /// in that session stay quiet (what was recalled of them is not
+    /// overwritten by a new reply). Discover then starts a new session,
+    /// which every lamp answers.
+    #[test]
+    fn a_street_remembered_is_read_at_once_and_only_new_lamps_are_looked_for() {
+        let usart = || Concentrator::usart(RequesterConfig::default());
+        let t = Box::new(SimTransport::street(6, Attach::Board, 57_600, 5));
+        let mut s = StreetSession::new(t, usart());
+        let late = street_address(6);
+        let sim = s.transport_mut().unwrap().simulator().unwrap();
+        sim.lamp(late, LampAction::Cut);
+        s.discover();
+        run(&mut s, 30 * S);
+        let (session, mut known) = s.remembered();
+        assert_eq!((session, known.len()), (1, 5));
+        // What was kept says stack 9.9: a lamp that answers again says 1.x.
+        for (_, d) in known.iter_mut() {
+            d.stack = plm_core::app::Release { major: 9, minor: 9 };
+        }
+
+        // The page reloads; the boards keep what they were told.
+        let mut t = s.transport.take().unwrap();
+        t.simulator().unwrap().lamp(late, LampAction::Join);
+        let mut s = StreetSession::new(t, usart());
+        s.recall(session, known.clone());
+        assert_eq!(s.fleet().len(), 5, "the lamps are in the fleet at once");
+        assert!(s.take().changed);
+        let mut discovery_seen = false;
+        for _ in 0..300 {
+            run(&mut s, 100 * MS);
+            if s.discovering().is_some() {
+                discovery_seen = true;
+                let unread: Vec<_> = known
+                    .iter()
+                    .filter(|(a, _)| s.fleet()[a].state().is_none())
+                    .collect();
+                assert!(unread.is_empty(), "read before any discovery: {unread:?}");
+            }
+        }
+        assert!(discovery_seen, "a discovery looked for new lamps");
+        assert!(s.discovering().is_none());
+        assert_eq!(s.fleet().len(), 6, "the lamp powered later is found");
+        assert!(s.fleet()[&late].discovered.is_some());
+        for (a, d) in &known {
+            assert_eq!(s.fleet()[a].discovered, Some(*d), "{a} stayed quiet");
+        }
+        assert_eq!(s.remembered().0, session, "the same session");
+        assert_eq!(s.remembered().1.len(), 6);
+
+        s.discover();
+        run(&mut s, 30 * S);
+        assert_eq!(s.remembered().0, session + 1, "Discover: a new session");
+        for (a, _) in &known {
+            let stack = s.fleet()[a].discovered.unwrap().stack;
+            assert_ne!(stack.major, 9, "{a} answered the new session");
         }
     }
 

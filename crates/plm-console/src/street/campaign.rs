@@ -172,6 +172,7 @@ impl StreetSession {
         }
         self.out.campaign = true;
         self.out.changed = true;
+        self.out.found = true;
         if sweep {
             self.set_sweep(true);
         }
