@@ -208,6 +208,27 @@ fn discover_status_and_dim_a_street() {
     assert_eq!(lamps, want, "{found:?}");
     assert!(found.err.contains("3 boards found"), "{}", found.err);
 
+    // `status all`: the street found again and every lamp read, one
+    // JSON object each.
+    let all = board(
+        &mut server,
+        &dir,
+        "status-all",
+        &["status", "all", "--json", "--guess", "3"],
+    );
+    assert_eq!(all.code, Some(0), "{all:?}");
+    let mut read: Vec<String> = json_lines(&all.out)
+        .iter()
+        .map(|v| {
+            assert_eq!(v["state"], "RUN", "{v}");
+            assert!(v["lamp_power_w"].as_u64().is_some_and(|w| w > 0), "{v}");
+            v["address"].as_str().unwrap().to_string()
+        })
+        .collect();
+    read.sort();
+    assert_eq!(read, (1..=3).map(lamp).collect::<Vec<_>>(), "{all:?}");
+    assert!(all.err.contains("3 lamp(s) read, 0 silent"), "{}", all.err);
+
     let s = board(&mut server, &dir, "status", &["status", &lamp(2)]);
     assert_eq!(s.code, Some(0), "{s:?}");
     assert!(

@@ -54,6 +54,67 @@ pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u
     Ok(exit::OK)
 }
 
+/// `status all`: discovers the street, then reads every lamp found (its
+/// HID ballast parameters), one line (or JSON object) per lamp.
+pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
+    let started = std::time::Instant::now();
+    tell!("plm board: discovering, then reading every lamp found");
+    let found = d.discover(config, |_, _| {})?.found().to_vec();
+    tell!(
+        "plm board: {} board(s) found in {:.1} s; reading them",
+        found.len(),
+        started.elapsed().as_secs_f64()
+    );
+    let mut silent = 0;
+    for (address, info) in &found {
+        let got = refused(d.ask(*address, Message::Hid(Hid::Get(hid::ALL)))?);
+        let lamp = match &got {
+            Ok(Message::Hid(Hid::Reply { param, value })) if *param == hid::ALL => {
+                Ballast::decode(value).ok_or_else(|| String::from("a short ballast reply"))
+            }
+            Ok(other) => Err(format!("answered {other:?}")),
+            Err(why) => Err(why.clone()),
+        };
+        silent += usize::from(got.is_err());
+        if json {
+            let mut o = json!({
+                "address": address.to_string(),
+                "firmware": info.firmware.to_string(),
+                "snr_db": info.snr,
+            });
+            match &lamp {
+                Ok(b) => {
+                    o["state"] = b.state().to_string().into();
+                    o["lamp_power_w"] = b.lamp_power.into();
+                    o["temperature_c"] = b.temperature.into();
+                }
+                Err(why) => o["error"] = why.as_str().into(),
+            }
+            say!("{o}");
+        } else {
+            let what = match &lamp {
+                Ok(b) => format!("{}, {} W, {} °C", b.state(), b.lamp_power, b.temperature),
+                Err(why) => why.clone(),
+            };
+            say!(
+                "{address}  firmware {}  SNR {} dB  {what}",
+                info.firmware,
+                info.snr
+            );
+        }
+    }
+    tell!(
+        "plm board: {} lamp(s) read, {silent} silent, in {:.1} s",
+        found.len() - silent,
+        started.elapsed().as_secs_f64()
+    );
+    Ok(if found.is_empty() || silent > 0 {
+        exit::FAILED
+    } else {
+        exit::OK
+    })
+}
+
 /// What one request of `status` gave: the answer, or why there is none.
 type Got = Result<Message, String>;
 

@@ -164,9 +164,13 @@ pub enum BoardCommand {
     /// Read what a board offers: firmware release, lamp (HID ballast),
     /// clock, GPIO, SNR.
     Status {
-        /// The board's address (12 hex digits, e.g. 0080e1000001).
-        #[arg(value_parser = parse_address)]
-        node: Address,
+        /// The board's address (12 hex digits, e.g. 0080e1000001), or
+        /// `all`: discover the street, then read every lamp found.
+        #[arg(value_parser = parse_target)]
+        node: Target,
+        /// With `all`: how many boards you expect.
+        #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..=4095))]
+        guess: u16,
     },
     /// Set the dimming level of one lamp, or of every lamp at once.
     Dim {
@@ -284,9 +288,15 @@ fn dispatch(args: BoardArgs) -> Result<u8, Failure> {
             config.older_rule = *older_rule;
             info::discover(&mut d, config, args.json)
         }
-        BoardCommand::Status { node } => {
+        BoardCommand::Status { node, guess } => {
             let mut d = connect(&args)?;
-            info::status(&mut d, *node, args.json)
+            match node {
+                Target::One(node) => info::status(&mut d, *node, args.json),
+                Target::All => {
+                    let config = DiscoveryConfig::new(session(), *guess as usize);
+                    info::status_all(&mut d, config, args.json)
+                }
+            }
         }
         BoardCommand::Dim { target, level } => {
             let mut d = connect(&args)?;
