@@ -136,10 +136,11 @@ pub struct StreetStore {
     pub alerts: RwSignal<VecDeque<Raised>>,
     /// The background sweep.
     pub sweep: RwSignal<Sweep>,
-    /// The discovery round running, if any (a u64, not the round's u8:
-    /// a signal type of its own would bring its own copy of the signal
-    /// code, docs/console.md "Size").
-    pub discovering: RwSignal<Option<(usize, usize)>>,
+    /// While a discovery runs: the lamps found (high 32 bits) and how
+    /// many it believes are left (low 32), packed in a u64: a signal type
+    /// of its own would bring its own copy of the signal code
+    /// (docs/console.md "Size").
+    pub discovering: RwSignal<Option<u64>>,
     /// What the street is reached through, in words.
     pub port: RwSignal<String>,
     /// Application frames sent to the street so far.
@@ -727,7 +728,10 @@ impl Console {
         let (sweep, discovering, now) = {
             let session = self.street.session();
             let s = session.borrow();
-            (s.sweep(), s.discovering(), s.now())
+            let packed = s
+                .discovering()
+                .map(|(found, left)| ((found as u64) << 32) | left as u64);
+            (s.sweep(), packed, s.now())
         };
         let street = self.street;
         set_if_changed(street.sweep, sweep);

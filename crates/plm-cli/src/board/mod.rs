@@ -149,8 +149,8 @@ pub struct BoardArgs {
 /// What to do.
 #[derive(Subcommand)]
 pub enum BoardCommand {
-    /// Find the boards on the line (SERVICE_NET_DISCOVER_REQ in rounds
-    /// until the line is quiet); one line per board found.
+    /// Find the boards on the line (SERVICE_NET_DISCOVER_REQ in slotted
+    /// frames until it is sure nobody is left); one line per board found.
     Discover {
         /// How many boards you expect (half or twice the truth costs a
         /// few frames, never a board).

@@ -55,7 +55,7 @@ pub fn StreetView() -> impl IntoView {
         <div class="street">
             <div class="toolbar">
                 <span class="muted" id="street-port">{move || street.port.get()}</span>
-                {button("street-discover", "Discover", "", move || street.act(|s| s.discover()))}
+                {button("street-discover", "Discover", "finds every lamp again; the lamps found are kept in this browser for this connection, read at once when it opens again", move || street.act(|s| s.discover()))}
                 <SweepControl/>
                 {text_input("street-filter", "", "filter: address, state, \"trouble\"", None, filter)}
                 {button("street-export-csv", "Export CSV", "", move || export(false))}
@@ -197,7 +197,7 @@ fn SweepControl() -> impl IntoView {
         </label>
         <span id="street-progress" class="muted">
             {move || match (street.discovering.get(), street.sweep.get()) {
-                (Some((found, left)), _) => format!("discovering: {found} found, about {left} left…"),
+                (Some(d), _) => format!("discovering: {} found, about {} left…", d >> 32, d & 0xFFFF_FFFF),
                 (None, s) if s.on && s.total > 0 => format!("reading {}/{} (sweep {})", s.done, s.total, s.rounds + 1),
                 (None, s) if s.on => format!(
                     "{} sweep{} done; next in a few seconds",
