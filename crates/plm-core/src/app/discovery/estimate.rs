@@ -55,19 +55,20 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// Before any frame: about `guess` boards (a bell of width `guess / 2`
-    /// around it, [`BELL`] of the belief), and any number up to 16 times
-    /// the guess (the rest, spread evenly over the orders of magnitude):
-    /// a street far larger than guessed is still looked for, by frames
-    /// that only a few boards answer, and a belief that gathers at its
-    /// top grows (up to [`MOST`]).
+    /// Before any frame: about `guess` boards (from half of it to twice
+    /// it, [`BELL`] of the belief), and any number up to [`MOST`] (the
+    /// rest, spread evenly over the orders of magnitude): a street far
+    /// larger than guessed (the console's first guess is 12) is still
+    /// looked for, by frames that only a few boards answer.
     pub fn new(guess: usize) -> Estimate {
         let g = guess.max(1) as f64;
-        let top = (16 * guess).clamp(64, MOST);
+        let top = MOST;
         let bell: Vec<f64> = (0..=top)
             .map(|n| {
-                let x = 2.0 * (n as f64 - g) / g;
-                1.0 / (1.0 + x * x * x * x)
+                // Flat from half the guess to twice it, steep outside.
+                let x = (n as f64 - 1.25 * g) / (0.75 * g);
+                let x4 = x * x * x * x;
+                1.0 / (1.0 + x4 * x4)
             })
             .collect();
         let bell_total: f64 = bell.iter().sum();
@@ -132,14 +133,6 @@ impl Estimate {
             // what was heard.
             self.belief = Estimate::new(new.max(1)).belief;
         }
-        // Gathered at its top: the street is larger than the belief
-        // holds; it grows, the new part as likely as its top.
-        let top = self.belief.len();
-        if top <= MOST && self.belief[top - top / 8..].iter().sum::<f64>() > 0.01 {
-            let edge = self.belief[top - 1];
-            self.belief.resize((2 * top).min(MOST + 1), edge);
-            self.normalise();
-        }
     }
 
     /// The next frame: the slots and share that find the most boards
@@ -184,7 +177,7 @@ impl Estimate {
 pub const MOST: usize = 4_095;
 
 /// The share of the first belief that is the bell around the guess.
-const BELL: f64 = 0.98;
+const BELL: f64 = 0.998;
 
 /// A chance below this is taken as none.
 const NEGLIGIBLE: f64 = 1e-15;
