@@ -27,28 +27,65 @@ const row = (page, n) => page.locator(`#fleet-table tbody tr[data-address="${lam
 const cell = (page, n, key) => row(page, n).locator(`td[data-key="${key}"]`);
 const number = async (page, n, key) => Number(await cell(page, n, key).textContent());
 
-/** A fresh page, waiting until every lamp of the street was found and read. */
-async function open(t) {
+/** The state cells of the fleet table, all read (`RUN`), `n` of them. */
+const allRead = (n) => {
+  const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+  return cells.length === n && cells.every((c) => c.textContent === 'RUN');
+};
+
+/**
+ * Records in the page, at every frame drawn, what the Street view shows
+ * (rows, rows read, progress, frames sent) whenever it changes, with the
+ * page's time: `window.streetLog`.
+ */
+const recordStreet = () => {
+  window.streetLog = [];
+  let last = '';
+  const look = () => {
+    const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+    const now = {
+      rows: cells.length,
+      read: cells.filter((c) => c.textContent === 'RUN').length,
+      progress: document.querySelector('#street-progress')?.textContent ?? '',
+      sent: parseInt(document.querySelector('#street-sent')?.textContent ?? '0', 10),
+    };
+    const key = JSON.stringify(now);
+    if (key !== last) {
+      last = key;
+      window.streetLog.push({ at: performance.now(), ...now });
+    }
+    requestAnimationFrame(look);
+  };
+  requestAnimationFrame(look);
+};
+
+/**
+ * A fresh page, waiting until every lamp of the street was found and
+ * read; `meanwhile(page)` is called once the page is there.
+ */
+async function open(t, meanwhile = async () => {}) {
   const context = await browser.newContext({
     acceptDownloads: true,
     viewport: { width: 1400, height: 900 },
   });
   const page = await watchedPage(t, context);
+  await page.addInitScript(recordStreet);
   await page.goto(base);
   await page.locator('#view-street').waitFor({ state: 'visible' });
-  await page.waitForFunction(
-    (n) => {
-      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
-    },
-    LAMPS,
-    { timeout: 60_000, polling: 250 },
-  );
+  await meanwhile(page);
+  await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
   return page;
 }
 
-test('the page opens on the simulated street: every lamp found, read and lit', async (t) => {
-  const page = await open(t);
+/** The page's time (s) at which the Street view first showed every lamp read. */
+const filledAt = async (page) =>
+  page.evaluate((n) => window.streetLog.find((s) => s.rows === n && s.read === n).at / 1000, LAMPS);
+
+test('the page opens on the simulated street: every lamp found, read and lit within 10 s', async (t) => {
+  const page = await open(t, async (page) => {
+    await page.locator('#street-progress', { hasText: /discovering: [1-9]/ }).waitFor();
+    await shot(page, 'street-discovering');
+  });
   assert.equal(await page.getAttribute('#tab-street', 'aria-selected'), 'true');
   assert.match(await page.textContent('#street-port'), /concentrator board \(simulated, 12 lamps\)/);
   for (let n = 1; n <= LAMPS; n++) {
@@ -57,6 +94,61 @@ test('the page opens on the simulated street: every lamp found, read and lit', a
     assert.ok((await cell(page, n, 'snr').textContent()) !== '', `lamp ${n} has an SNR`);
   }
   await shot(page, 'street');
+  // While discovery runs the view says how many were found and are left,
+  // and each lamp's row is there as soon as it is heard.
+  const log = await page.evaluate(() => window.streetLog);
+  const discovering = log.filter((s) => s.progress.startsWith('discovering:'));
+  assert.match(discovering[0].progress, /^discovering: 0 found, about \d+ left…$/);
+  assert.ok(
+    discovering.some((s) => s.rows > 0 && s.rows < LAMPS && s.progress.startsWith(`discovering: ${s.rows} found`)),
+    'rows appear one by one while discovery runs',
+  );
+  const filled = await filledAt(page);
+  t.diagnostic(`every lamp's row filled at ${filled.toFixed(2)} s of page time`);
+  assert.ok(filled <= 10, `every row filled at ${filled.toFixed(2)} s of page time, more than 10 s`);
+});
+
+test('after a reload the known lamps are read at once, without a discovery; then it looks for new ones', async (t) => {
+  const page = await open(t);
+  // What was found is kept for this connection.
+  const kept = await page.evaluate(() => Object.keys(localStorage).filter((k) => k.startsWith('plm-console.street')));
+  assert.equal(kept.length, 2, `the index and one street: ${kept}`);
+  await page.reload();
+  // Every lamp is in the table before any is read.
+  await page.waitForFunction((n) => document.querySelectorAll('#fleet-table tbody tr').length === n, LAMPS);
+  await shot(page, 'street-reloaded');
+  await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
+  const filled = await filledAt(page);
+  t.diagnostic(`after the reload every lamp's row filled at ${filled.toFixed(2)} s of page time`);
+  assert.ok(filled <= 10, `every row filled at ${filled.toFixed(2)} s of page time after the reload`);
+  const log = await page.evaluate(() => window.streetLog);
+  const before = log.filter((s) => s.at <= filled * 1000);
+  assert.deepEqual(
+    before.filter((s) => s.progress.startsWith('discovering')),
+    [],
+    'no discovery before every lamp was read',
+  );
+  assert.ok(before.every((s) => s.rows === 0 || s.rows === LAMPS), 'the known lamps came at once');
+  // Two requests per lamp (its state, its SNR): a discovery frame would be one more.
+  const sent = before.at(-1).sent;
+  assert.ok(sent <= 2 * LAMPS, `${sent} frames sent until every lamp was read`);
+  // Then a discovery of the same session looks for new lamps, and finds none.
+  await page.waitForFunction(() => window.streetLog.some((s) => s.progress.startsWith('discovering')), null, {
+    timeout: 30_000,
+  });
+  await page.locator('#street-progress', { hasText: 'sweep' }).waitFor({ timeout: 60_000 });
+  assert.equal(await page.locator('#fleet-table tbody tr').count(), LAMPS);
+  await shot(page, 'street-reloaded-read');
+
+  // A record that cannot be read is forgotten, said in words, and the
+  // street discovered again.
+  await page.evaluate(() => {
+    for (const k of Object.keys(localStorage)) if (k.startsWith('plm-console.street.')) localStorage.setItem(k, '1 zz 00');
+  });
+  await page.reload();
+  await page.locator('#link-problem', { hasText: 'cannot be read (its session is not two hex digits); it is forgotten and the street is discovered again' }).waitFor();
+  await page.locator('#street-progress', { hasText: 'discovering' }).waitFor();
+  await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
 });
 
 test('a column header sorts the fleet table by it, the other way on a second click', async (t) => {

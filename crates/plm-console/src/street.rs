@@ -143,6 +143,9 @@ pub struct StreetSession {
     conc: Concentrator,
     pacer: Pacer,
     discovery: Option<Discovery>,
+    /// Boards the discovery had found when its current frame began (its
+    /// belief of those left is updated at the end of each frame).
+    found_before_frame: usize,
     session_no: u8,
     /// A street recalled: once its lamps are read, discovery looks for
     /// new ones.
@@ -168,6 +171,7 @@ impl StreetSession {
             conc,
             pacer: Pacer::default(),
             discovery: None,
+            found_before_frame: 0,
             session_no: 0,
             look_for_new: false,
             sweep: Sweep::default(),
@@ -231,11 +235,14 @@ impl StreetSession {
     }
 
     /// Whether a discovery is running: the boards found so far and how
-    /// many it believes are left.
+    /// many it believes are left (less those heard since its belief was
+    /// last updated).
     pub fn discovering(&self) -> Option<(usize, usize)> {
-        self.discovery
-            .as_ref()
-            .map(|d| (d.found().len(), (d.left() + 0.5) as usize))
+        self.discovery.as_ref().map(|d| {
+            let found = d.found().len();
+            let heard = found.saturating_sub(self.found_before_frame);
+            (found, (d.left() - heard as f64 + 0.5).max(0.0) as usize)
+        })
     }
 
     /// Requests not yet answered.
@@ -251,6 +258,7 @@ impl StreetSession {
         let expected = self.fleet.len().max(12);
         let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, expected));
         self.discovery = Some(d);
+        self.found_before_frame = 0;
         self.out.found = true;
         self.conc.submit(now, first);
         self.flush();
@@ -267,8 +275,12 @@ impl StreetSession {
     /// once and read at once; then a discovery of the same session looks
     /// for new ones only (the boards heard in it stay quiet; one that
     /// restarted answers and is heard again).
+    /// A street of no lamp is discovered again, in a new session.
     pub fn recall(&mut self, session: u8, known: Vec<(Address, Discovered)>) {
         self.session_no = session;
+        if known.is_empty() {
+            return self.discover();
+        }
         for (a, d) in known {
             let lamp = self.lamp(a);
             lamp.discovered = Some(d);
@@ -277,6 +289,7 @@ impl StreetSession {
         self.look_for_new = true;
         self.out.changed = true;
         self.set_sweep(true);
+        self.sweep.total = self.fleet.len();
     }
 
     /// What to remember of the street: the discovery session its lamps
@@ -296,6 +309,7 @@ impl StreetSession {
         self.look_for_new = false;
         let (_, known) = self.remembered();
         let config = DiscoveryConfig::new(self.session_no, 1);
+        self.found_before_frame = known.len();
         let (d, first) = Discovery::resume(now, config, known);
         self.discovery = Some(d);
         self.out.changed = true;
@@ -450,6 +464,7 @@ impl StreetSession {
             return;
         };
         if let Some(next) = d.handle_timeout(now) {
+            self.found_before_frame = d.found().len();
             self.conc.submit(now, next);
         }
         if d.is_done() {
@@ -856,6 +871,18 @@ mod tests {
             let stack = s.fleet()[a].discovered.unwrap().stack;
             assert_ne!(stack.major, 9, "{a} answered the new session");
         }
+    }
+
+    /// A street remembered with no lamp is discovered again, in a new
+    /// session.
+    #[test]
+    fn a_street_remembered_empty_is_discovered_again() {
+        let t = Box::new(SimTransport::street(3, Attach::Board, 57_600, 6));
+        let mut s = StreetSession::new(t, Concentrator::usart(RequesterConfig::default()));
+        s.recall(4, Vec::new());
+        assert_eq!(s.remembered().0, 5);
+        run(&mut s, 30 * S);
+        assert_eq!(s.fleet().len(), 3);
     }
 
     /// Random failures set from the console (the Simulator view's rate)
