@@ -56,13 +56,14 @@ pub struct Estimate {
 
 impl Estimate {
     /// Before any frame: about `guess` boards (from half of it to twice
-    /// it, [`BELL`] of the belief), and any number up to [`MOST`] (the
-    /// rest, spread evenly over the orders of magnitude): a street far
-    /// larger than guessed (the console's first guess is 12) is still
-    /// looked for, by frames that only a few boards answer.
+    /// it, [`BELL`] of the belief), and any number up to 64 times the
+    /// guess (at least 256, at most [`MOST`]; the rest, spread evenly
+    /// over the orders of magnitude): a street far larger than guessed
+    /// (the console's first guess is 12) is still looked for, by frames
+    /// that only a few boards answer.
     pub fn new(guess: usize) -> Estimate {
         let g = guess.max(1) as f64;
-        let top = MOST;
+        let top = (64 * guess).clamp(256, MOST);
         let bell: Vec<f64> = (0..=top)
             .map(|n| {
                 // Flat from half the guess to twice it, steep outside.
