@@ -146,6 +146,8 @@ pub struct StreetSession {
     /// Boards the discovery had found when its current frame began (its
     /// belief of those left is updated at the end of each frame).
     found_before_frame: usize,
+    /// The discovery running is a sweep's one-frame look for new boards.
+    probing: bool,
     session_no: u8,
     /// A street recalled: once its lamps are read, discovery looks for
     /// new ones.
@@ -172,6 +174,7 @@ impl StreetSession {
             pacer: Pacer::default(),
             discovery: None,
             found_before_frame: 0,
+            probing: false,
             session_no: 0,
             look_for_new: false,
             sweep: Sweep::default(),
@@ -238,7 +241,7 @@ impl StreetSession {
     /// many it believes are left (less those heard since its belief was
     /// last updated).
     pub fn discovering(&self) -> Option<(usize, usize)> {
-        self.discovery.as_ref().map(|d| {
+        self.discovery.as_ref().filter(|_| !self.probing).map(|d| {
             let found = d.found().len();
             let heard = found.saturating_sub(self.found_before_frame);
             (found, (d.left() - heard as f64 + 0.5).max(0.0) as usize)
@@ -468,12 +471,36 @@ impl StreetSession {
             self.conc.submit(now, next);
         }
         if d.is_done() {
+            let new = d.found().len() > self.found_before_frame;
             self.discovery = None;
             self.out.changed = true;
+            if std::mem::take(&mut self.probing) {
+                // A probe heard a new board: a discovery names it and
+                // looks for more; else the sweep goes on as planned.
+                if new {
+                    self.look_for_new(now);
+                }
+                return;
+            }
             // A street just found is read at once.
             self.next_sweep = Some(now);
             self.sweep.on = true;
         }
+    }
+
+    /// A sweep's look for new boards (issue: a lamp replaced or powered
+    /// later): one short frame in the session its lamps were heard in.
+    fn probe(&mut self, now: Instant) {
+        let (_, known) = self.remembered();
+        self.found_before_frame = known.len();
+        let config = DiscoveryConfig {
+            max_frames: 1,
+            ..DiscoveryConfig::new(self.session_no, 1)
+        };
+        let (d, first) = Discovery::resume(now, config, known);
+        self.discovery = Some(d);
+        self.probing = true;
+        self.conc.submit(now, first);
     }
 
     fn run_sweep(&mut self, now: Instant) {
@@ -505,6 +532,8 @@ impl StreetSession {
                 self.out.changed = true;
                 if self.look_for_new {
                     self.look_for_new(now);
+                } else if !self.fleet.is_empty() {
+                    self.probe(now);
                 }
             }
         }
@@ -871,6 +900,38 @@ mod tests {
             let stack = s.fleet()[a].discovered.unwrap().stack;
             assert_ne!(stack.major, 9, "{a} answered the new session");
         }
+    }
+
+    /// A lamp powered after the discovery is found by a sweep's probe (one
+    /// short frame of the same session after each round), without a
+    /// discovery the page shows; the lamps already heard stay quiet.
+    #[test]
+    fn a_lamp_powered_later_is_found_by_the_sweep() {
+        let usart = Concentrator::usart(RequesterConfig::default());
+        let t = Box::new(SimTransport::street(6, Attach::Board, 57_600, 7));
+        let mut s = StreetSession::new(t, usart);
+        let late = street_address(4);
+        let sim = s.transport_mut().unwrap().simulator().unwrap();
+        sim.lamp(late, LampAction::Cut);
+        s.discover();
+        run(&mut s, 30 * S);
+        assert_eq!(s.fleet().len(), 5);
+        let sim = s.transport_mut().unwrap().simulator().unwrap();
+        sim.lamp(late, LampAction::Join);
+        let mut shown = false;
+        for _ in 0..400 {
+            run(&mut s, 100 * MS);
+            shown |= s.discovering().is_some() && s.fleet().len() == 5;
+            if s.fleet().contains_key(&late) {
+                break;
+            }
+        }
+        assert!(
+            s.fleet().contains_key(&late),
+            "the lamp powered later is found"
+        );
+        assert!(!shown, "a sweep's probe is not a discovery the page shows");
+        assert_eq!(s.remembered().0, 1, "in the same session");
     }
 
     /// A street remembered with no lamp is discovered again, in a new
