@@ -4,12 +4,12 @@
 //!
 //! A connection is what identifies it: the profile, the port in words
 //! (a WebSerial port's USB ids, a simulated street's size), the baud
-//! rate and a simulated street's seed. Each is kept under its own key,
-//! `1 SS HEX`: the record's layout, the discovery session (two hex digits)
-//! and, per lamp, its 6-byte address then its discovery reply's data
-//! (board protocol 0Bh, as plm-core writes it). An index lists the
-//! connections, the one used last first; the oldest goes beyond
-//! [`CONNECTIONS`].
+//! rate and a simulated street's seed. One key holds a line per
+//! connection, the one used last first (the oldest goes beyond
+//! [`CONNECTIONS`]): its name, a tab, then `1 SS HEX`: the record's
+//! layout, the discovery session (two hex digits) and, per lamp, its
+//! 6-byte address then its discovery reply's data (board protocol 0Bh,
+//! as plm-core writes it).
 
 use crate::storage::{load, store};
 use plm_core::app::service::{Discovered, Service};
@@ -21,8 +21,7 @@ pub const CONNECTIONS: usize = 4;
 /// Lamps of one street remembered at most; a larger street is not kept.
 pub const LAMPS: usize = 1000;
 
-const INDEX: &str = "plm-console.streets";
-const PREFIX: &str = "plm-console.street.";
+const KEY: &str = "plm-console.streets";
 /// Bytes of one lamp: its address and its reply's data.
 const LAMP_BYTES: usize = 6 + 5;
 
@@ -39,11 +38,10 @@ pub struct Remembered {
 /// What identifies a connection, in words: `profile`, the transport's
 /// port and baud rate, and a simulated world's `seed`.
 pub fn connection(profile: &str, port: &str, baud: u32, seed: Option<u64>) -> String {
-    let mut id = format!("{profile} · {port} · {baud} Bd");
-    if let Some(s) = seed {
-        id.push_str(&format!(" · seed {s}"));
+    match seed {
+        Some(s) => format!("{profile} · {port} · {baud} Bd · seed {s}"),
+        None => format!("{profile} · {port} · {baud} Bd"),
     }
-    id.replace('\n', " ")
 }
 
 /// A session number for a street this browser does not know: from the
@@ -74,63 +72,66 @@ pub fn encode(r: &Remembered) -> Option<String> {
 
 /// Reads a record, or says in words what is wrong with it.
 pub fn decode(text: &str) -> Result<Remembered, String> {
-    let mut parts = text.split(' ');
-    if parts.next() != Some("1") {
+    let fields: Vec<&str> = text.split(' ').collect();
+    let ["1", session, lamps] = fields[..] else {
         return Err("it is not a street record of this console".into());
-    }
-    let session = parts
-        .next()
-        .filter(|s| s.len() == 2)
-        .and_then(|s| u8::from_str_radix(s, 16).ok())
-        .ok_or("its session is not two hex digits")?;
-    let bytes = hex::parse(parts.next().unwrap_or(""))
-        .map_err(|_| "its lamps are not hex digits".to_string())?;
-    if parts.next().is_some() {
-        return Err("it has more fields than a record has".into());
-    }
+    };
+    let session = match hex::parse(session) {
+        Ok(b) if session.len() == 2 => b[0],
+        _ => return Err("its session is not two hex digits".into()),
+    };
+    let bytes = hex::parse(lamps).map_err(|_| "its lamps are not hex digits".to_string())?;
     if bytes.len() % LAMP_BYTES != 0 {
-        return Err(format!(
-            "its lamps are {} bytes, not a multiple of {LAMP_BYTES}",
-            bytes.len()
-        ));
+        return Err("its lamps are not 11 bytes each".into());
     }
-    if bytes.len() / LAMP_BYTES > LAMPS {
-        return Err(format!("it has more than {LAMPS} lamps"));
+    if bytes.len() > LAMPS * LAMP_BYTES {
+        return Err("it has more than 1000 lamps".into());
     }
-    let lamps = bytes
-        .chunks(LAMP_BYTES)
-        .map(|c| {
-            let mut payload = vec![0x0b];
-            payload.extend_from_slice(&c[6..]);
-            match Service::parse(&payload) {
-                Ok(Service::DiscoverReply(d)) => Ok((Address(c[..6].try_into().unwrap()), d)),
-                _ => Err("a lamp's discovery reply cannot be read".to_string()),
-            }
-        })
-        .collect::<Result<_, _>>()?;
-    Ok(Remembered { session, lamps })
+    let mut r = Remembered {
+        session,
+        lamps: Vec::new(),
+    };
+    for c in bytes.chunks(LAMP_BYTES) {
+        let mut payload = vec![0x0b];
+        payload.extend_from_slice(&c[6..]);
+        let Ok(Service::DiscoverReply(d)) = Service::parse(&payload) else {
+            return Err("a lamp's discovery reply cannot be read".into());
+        };
+        let mut a = Address::default();
+        a.0.copy_from_slice(&c[..6]);
+        r.lamps.push((a, d));
+    }
+    Ok(r)
 }
 
-/// The index after `id` was used: first, at most [`CONNECTIONS`]; and
-/// the connections that fell out of it.
-pub fn reorder(index: &str, id: &str) -> (String, Vec<String>) {
-    let mut ids: Vec<&str> = vec![id];
-    ids.extend(index.lines().filter(|l| !l.is_empty() && *l != id));
-    let dropped = ids.split_off(ids.len().min(CONNECTIONS));
-    (
-        ids.join("\n"),
-        dropped.into_iter().map(String::from).collect(),
-    )
+/// The streets kept, `all`, after connection `id` was used: its
+/// `record` first (none: forgotten), at most [`CONNECTIONS`].
+pub fn put(all: &str, id: &str, record: Option<&str>) -> String {
+    let mut lines: Vec<String> = record.map(|r| format!("{id}\t{r}")).into_iter().collect();
+    lines.extend(
+        all.lines()
+            .filter(|l| l.split('\t').next() != Some(id))
+            .map(String::from),
+    );
+    lines.truncate(CONNECTIONS);
+    lines.join("\n")
+}
+
+/// The record kept for connection `id` in `all`, if any.
+pub fn find<'a>(all: &'a str, id: &str) -> Option<&'a str> {
+    all.lines()
+        .find_map(|l| l.strip_prefix(id)?.strip_prefix('\t'))
 }
 
 /// The street remembered for connection `id`, if any; a record that
 /// cannot be read is forgotten, and why is returned in words.
 pub fn recall(id: &str) -> Result<Option<Remembered>, String> {
-    let Some(text) = load(&format!("{PREFIX}{id}")) else {
+    let all = load(KEY).unwrap_or_default();
+    let Some(text) = find(&all, id) else {
         return Ok(None);
     };
-    decode(&text).map(Some).map_err(|why| {
-        forget(id);
+    decode(text).map(Some).map_err(|why| {
+        store(KEY, Some(&put(&all, id, None)));
         format!("The street kept in this browser for {id} cannot be read ({why}); it is forgotten and the street is discovered again.")
     })
 }
@@ -138,26 +139,8 @@ pub fn recall(id: &str) -> Result<Option<Remembered>, String> {
 /// Remembers `r` for connection `id` (a street beyond [`LAMPS`] is
 /// forgotten instead: its lamps left out would stay quiet).
 pub fn save(id: &str, r: &Remembered) {
-    let Some(text) = encode(r) else {
-        return forget(id);
-    };
-    let index = load(INDEX).unwrap_or_default();
-    if index.lines().next() != Some(id) {
-        let (index, dropped) = reorder(&index, id);
-        for old in dropped {
-            store(&format!("{PREFIX}{old}"), None);
-        }
-        store(INDEX, Some(&index));
-    }
-    store(&format!("{PREFIX}{id}"), Some(&text));
-}
-
-/// Forgets what was kept for connection `id`.
-pub fn forget(id: &str) {
-    store(&format!("{PREFIX}{id}"), None);
-    let index = load(INDEX).unwrap_or_default();
-    let rest: Vec<&str> = index.lines().filter(|l| *l != id).collect();
-    store(INDEX, Some(&rest.join("\n")));
+    let all = load(KEY).unwrap_or_default();
+    store(KEY, Some(&put(&all, id, encode(r).as_deref())));
 }
 
 #[cfg(test)]
@@ -194,6 +177,8 @@ mod tests {
         ] {
             let text = encode(&r).unwrap();
             assert_eq!(decode(&text), Ok(r.clone()), "{text:.60}");
+            let all = put("", "a connection", Some(&text));
+            assert_eq!(find(&all, "a connection").map(decode), Some(Ok(r)));
         }
         let one = encode(&street(0x2a, 1)).unwrap();
         // Address, firmware 1.4, stack 2.1, SNR 1.
@@ -204,24 +189,29 @@ mod tests {
     fn a_street_beyond_the_bound_is_not_kept() {
         assert!(encode(&street(1, LAMPS as u64 + 1)).is_none());
         let over = format!("1 01 {}", "0080e10000010104020101".repeat(LAMPS + 1));
-        assert_eq!(
-            decode(&over),
-            Err(format!("it has more than {LAMPS} lamps"))
-        );
+        assert_eq!(decode(&over), Err("it has more than 1000 lamps".into()));
+        // Saved beyond the bound, a street is forgotten.
+        assert_eq!(put("a\t1 01 ", "a", None), "");
     }
 
     #[test]
-    fn the_index_keeps_the_connections_used_last() {
-        let mut index = String::new();
-        let mut dropped = Vec::new();
+    fn the_connections_used_last_are_kept() {
+        let mut all = String::new();
         for id in ["a", "b", "c", "d", "b", "e", "f"] {
-            let (i, d) = reorder(&index, id);
-            index = i;
-            dropped.extend(d);
+            all = put(&all, id, Some("1 01 "));
         }
-        assert_eq!(index, "f\ne\nb\nd");
-        assert_eq!(dropped, ["a", "c"]);
-        assert_eq!(index.lines().count(), CONNECTIONS);
+        assert_eq!(all, "f\t1 01 \ne\t1 01 \nb\t1 01 \nd\t1 01 ");
+        assert_eq!(all.lines().count(), CONNECTIONS);
+        assert_eq!(find(&all, "b"), Some("1 01 "));
+        assert_eq!(find(&all, "a"), None, "the oldest went");
+        assert_eq!(find(&all, "c"), None, "the oldest went");
+        let all = put(&all, "b", None);
+        assert_eq!(find(&all, "b"), None, "forgotten");
+        assert_eq!(find(&all, "d"), Some("1 01 "), "the others stay");
+        // A name that begins another is not it.
+        let both = put("ab\t1 02 ", "a", Some("1 03 "));
+        assert_eq!(find(&both, "ab"), Some("1 02 "));
+        assert_eq!(find(&both, "a"), Some("1 03 "));
     }
 
     #[test]
@@ -229,17 +219,12 @@ mod tests {
         let cases = [
             ("", "it is not a street record of this console"),
             ("2 01 ", "it is not a street record of this console"),
+            ("1 01", "it is not a street record of this console"),
+            ("1 01 00 extra", "it is not a street record of this console"),
             ("1 1 ", "its session is not two hex digits"),
             ("1 zz ", "its session is not two hex digits"),
             ("1 01 0080e1zz", "its lamps are not hex digits"),
-            (
-                "1 01 0080e1000001 extra",
-                "it has more fields than a record has",
-            ),
-            (
-                "1 01 0080e1000001",
-                "its lamps are 6 bytes, not a multiple of 11",
-            ),
+            ("1 01 0080e1000001", "its lamps are not 11 bytes each"),
         ];
         for (text, why) in cases {
             assert_eq!(decode(text), Err(why.to_string()), "{text:?}");
@@ -251,24 +236,23 @@ mod tests {
     #[test]
     fn a_connection_is_named_by_what_identifies_it() {
         let sim = connection(
-            "street-board",
+            "board",
             "concentrator board (simulated, 12 lamps)",
             57_600,
             Some(7580),
         );
         assert_eq!(
             sim,
-            "street-board · concentrator board (simulated, 12 lamps) · 57600 Bd · seed 7580"
+            "board · concentrator board (simulated, 12 lamps) · 57600 Bd · seed 7580"
         );
-        let port = connection("street-board", "USB 0483:5740 (WebSerial)", 57_600, None);
+        let port = connection("board", "USB 0483:5740 (WebSerial)", 57_600, None);
         assert_ne!(
             port,
-            connection("street-board", "USB 0483:5740 (WebSerial)", 19_200, None)
+            connection("board", "USB 0483:5740 (WebSerial)", 19_200, None)
         );
         assert_ne!(
             port,
-            connection("street-modem", "USB 0483:5740 (WebSerial)", 57_600, None)
+            connection("concentrator", "USB 0483:5740 (WebSerial)", 57_600, None)
         );
-        assert!(!connection("p", "a\nb", 1, None).contains('\n'));
     }
 }
