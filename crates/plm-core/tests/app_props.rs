@@ -7,7 +7,7 @@
 
 use plm_core::app::hid::{self, Hid};
 use plm_core::app::rfu;
-use plm_core::app::service::{Clock, Discovered, Release, Service};
+use plm_core::app::service::{Clock, Discovered, Release, Service, SlotRead};
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, ErrorCode, FrameError, FrameType, Happening,
     LineFrame, Message, Request, RequestId, Requester, RequesterConfig, UsartDecoder, UsartElement,
@@ -89,8 +89,16 @@ fn service() -> impl Strategy<Value = Service> {
                 snr,
             })
         }),
+        (any::<(u8, u8, u8)>(), vec(address(), 0..=SlotRead::MAX)).prop_map(
+            |((slot_ms, param, first_ms), addresses)| ReadInSlots(SlotRead {
+                slot_ms,
+                param,
+                first_ms,
+                addresses
+            })
+        ),
         // User commands this project does not know.
-        (0x13u8..=0xFF, vec(any::<u8>(), 0..MAX_PAYLOAD))
+        (0x14u8..=0xFF, vec(any::<u8>(), 0..MAX_PAYLOAD))
             .prop_map(|(command, data)| Raw { command, data }),
     ];
     let rfu = prop_oneof![

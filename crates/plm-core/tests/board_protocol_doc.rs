@@ -5,7 +5,7 @@
 //! the whole table as it must now read, to paste into the document.
 
 use plm_core::app::rfu::{self, image, Header, RfuReason, RfuState, Status};
-use plm_core::app::service::{Discovered, Release, Service};
+use plm_core::app::service::{Discovered, Release, Service, SlotRead};
 use plm_core::app::{Address, AppFrame, ErrorCode, FrameType, LineFrame, Message};
 
 const SPEC: &str = include_str!("../../../docs/board-protocol.md");
@@ -112,6 +112,18 @@ fn vectors() -> Vec<(&'static str, Vec<u8>)> {
         (
             "line-discover-reply",
             LineFrame::from_app(&reply.to(CONCENTRATOR), BOARD).emit(),
+        ),
+        (
+            "read-in-slots",
+            Message::Service(Service::ReadInSlots(SlotRead {
+                slot_ms: 50,
+                param: 0x0A,
+                first_ms: 20,
+                addresses: vec![BOARD],
+            }))
+            .broadcast(Address::BROADCAST)
+            .emit()
+            .unwrap(),
         ),
         ("image-crc32", header.crc.to_be_bytes().to_vec()),
         ("rfu-header", service(Service::RfuHeader(header))),

@@ -56,11 +56,11 @@ pub struct Timing {
     pub relay: Duration,
 }
 
-/// Line bytes of a discovery reply: the line frame's header and
-/// payload (13 + 6) and the DL layer's own (length, CRC).
-const REPLY_LINE_BYTES: u64 = 23;
-/// Line bytes of a request besides its heard addresses.
-const REQUEST_LINE_BYTES: u64 = 13 + 1 + SlotFrame::FIXED as u64 + 4;
+/// Line bytes of a frame besides its payload: the line frame's header
+/// (13) and the DL layer's own (length, CRC).
+const FRAME_LINE_BYTES: u64 = 17;
+/// Payload of a discovery reply (command and 5 data bytes).
+const REPLY_PAYLOAD: usize = 6;
 /// Room in a slot for a board's firmware answering late (the simulated
 /// boards' jitter is at most 4 ms) and the clocks' drift.
 const SLOT_GUARD: Duration = 6 * MS;
@@ -78,17 +78,34 @@ impl Timing {
     /// The product's default modulation, B-PSK.
     pub const BPSK: Timing = Timing::for_bit_rate(9_600);
 
-    /// One reply slot, ms.
+    /// A line frame of `payload` bytes on the line, sync included.
+    pub fn on_line(&self, payload: usize) -> Duration {
+        self.sync + (FRAME_LINE_BYTES + payload as u64) * self.line_byte
+    }
+
+    /// One slot for a reply of `payload` bytes, ms: the reply on the line
+    /// and the guard.
+    pub fn slot_ms_for(&self, payload: usize) -> u8 {
+        (self.on_line(payload) + SLOT_GUARD).div_ceil(MS).min(255) as u8
+    }
+
+    /// One discovery reply slot, ms.
     pub fn slot_ms(&self) -> u8 {
-        let us = self.sync + REPLY_LINE_BYTES * self.line_byte + SLOT_GUARD;
-        us.div_ceil(MS).min(255) as u8
+        self.slot_ms_for(REPLY_PAYLOAD)
+    }
+
+    /// How long an exchange of slots lasts, from handing over a request
+    /// of `request_payload` bytes to the last reply's arrival, when the
+    /// slots take `slots` after the request is heard.
+    pub fn slotted(&self, request_payload: usize, slots: Duration) -> Duration {
+        2 * self.relay + self.on_line(request_payload) + slots
     }
 
     /// How long a frame of `slots` whose request names `heard` boards
     /// lasts, from handing the request over to the last reply's arrival.
     pub fn frame(&self, slots: u8, heard: usize) -> Duration {
-        let request = self.sync + (REQUEST_LINE_BYTES + 6 * heard as u64) * self.line_byte;
-        2 * self.relay + request + slots as u64 * self.slot_ms() as u64 * MS
+        let request = 1 + SlotFrame::FIXED + 6 * heard;
+        self.slotted(request, slots as u64 * self.slot_ms() as u64 * MS)
     }
 }
 

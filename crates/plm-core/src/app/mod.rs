@@ -11,7 +11,8 @@
 //! - [`line`]: how a frame travels over the power line in a DL frame.
 //! - [`usart`]: the USART stream decoder; [`requester`]: requests and
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
-//!   USART or a bare ST7580; [`discovery`]: finding the boards on a line.
+//!   USART or a bare ST7580; [`discovery`]: finding the boards on a line;
+//!   [`read_all`]: reading many boards in slots.
 //! - [`rfu`]: remote firmware update, the layouts of its commands;
 //!   [`update`]: the engine that updates one board or a street.
 //!
@@ -26,6 +27,7 @@ pub mod frame;
 pub mod hid;
 pub mod line;
 pub mod message;
+pub mod read_all;
 pub mod requester;
 pub mod rfu;
 pub mod service;

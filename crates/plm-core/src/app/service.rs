@@ -29,6 +29,10 @@ pub const SNR_MAX: u8 = 31;
 /// First code of the user-defined service range ("0x0b to 0x7f";
 /// 0Bh-10h are taken by the native commands that follow in the enum).
 pub const USER_FIRST: u8 = 0x11;
+/// SERVICE_READ_IN_SLOTS, a user-defined command (4.5: 0Bh-7Fh; 11h-12h
+/// are the remote update's): the boards named read one HID parameter and
+/// answer it each in its slot (docs/protocol-notes.md, "Reads in slots").
+pub const READ_IN_SLOTS: u8 = 0x13;
 
 /// What answers a request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,6 +130,17 @@ pub mod fields {
     pub const DISCOVERY_SNR: Field = Field::uint("snr", "SNR of the request", 4, 1)
         .range(0, SNR_MAX as i64)
         .unit("dB");
+    /// Reads in slots: length of one reply slot.
+    pub const READ_SLOT_MS: Field = Field::uint("slot_ms", "Slot length", 0, 1)
+        .range(1, 255)
+        .unit("ms");
+    /// Reads in slots: the HID `param_to_get` each board reads.
+    pub const READ_PARAM: Field = Field::uint("param", "HID parameter", 1, 1);
+    /// Reads in slots: from the request heard to the first slot.
+    pub const READ_FIRST_MS: Field = Field::uint("first_ms", "First slot after", 2, 1).unit("ms");
+    /// Reads in slots: the boards named, 6 bytes each; the board at
+    /// index i answers in slot i.
+    pub const READ_ADDRESSES: Field = Field::bytes("addresses", "Boards, in slot order", 3, 0);
     /// Bytes not yet described (RFU, user commands).
     pub const DATA: Field = Field::bytes("data", "Data", 0, 0);
 
@@ -142,6 +157,8 @@ pub mod fields {
     /// NET_DISCOVER_REQ request, rule 2 (slotted frames).
     pub const DISCOVER_FRAME: &[Field] =
         &[RULE, FRAME_SESSION, FRAME, SLOTS, SLOT_MS, SHARE, HEARD];
+    /// READ_IN_SLOTS request.
+    pub const READ_IN_SLOTS: &[Field] = &[READ_SLOT_MS, READ_PARAM, READ_FIRST_MS, READ_ADDRESSES];
     /// NET_DISCOVER_REQ reply.
     pub const DISCOVERED: &[Field] = &[
         FIRMWARE_MAJOR,
@@ -155,8 +172,8 @@ pub mod fields {
 use fields as f;
 
 /// Every native service command (4.5, 4.6.4), by code, and the
-/// user-defined ones this project adds for the remote firmware update
-/// (11h-12h, [`rfu`]).
+/// user-defined ones this project adds: the remote firmware update
+/// (11h-12h, [`rfu`]) and reads in slots (13h).
 pub const COMMANDS: &[ServiceDesc] = &[
     ServiceDesc {
         code: 0x00,
@@ -311,6 +328,16 @@ pub const COMMANDS: &[ServiceDesc] = &[
         request_len: Some(1),
         answer: Answer::Ack,
     },
+    ServiceDesc {
+        code: READ_IN_SLOTS,
+        name: "SERVICE_READ_IN_SLOTS",
+        what: "Boards named read a HID parameter and answer it each in its slot",
+        request: f::READ_IN_SLOTS,
+        // 3 + 6 × 0..=15: any length is a request (the answers are HID
+        // replies, data frames).
+        request_len: None,
+        answer: Answer::None,
+    },
 ];
 
 /// The description of a command code.
@@ -450,6 +477,56 @@ impl SlotFrame {
     }
 }
 
+/// A SERVICE_READ_IN_SLOTS request (docs/protocol-notes.md, "Reads in
+/// slots"): the board at index i of `addresses` asks its ballast for
+/// `param` and sends the HID reply `first_ms + i × slot_ms` after hearing
+/// the request, or nothing if the ballast has not answered by then.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SlotRead {
+    /// Length of one slot, ms (1-255).
+    pub slot_ms: u8,
+    /// HID `param_to_get`.
+    pub param: u8,
+    /// From the request heard to slot 0, ms.
+    pub first_ms: u8,
+    /// The boards named, in slot order (at most [`SlotRead::MAX`]).
+    pub addresses: Vec<Address>,
+}
+
+impl SlotRead {
+    /// Data bytes before the addresses.
+    pub const FIXED: usize = 3;
+    /// Boards one request names (3 + 6 × 15 = 93 data bytes in the
+    /// 100-byte payload).
+    pub const MAX: usize = 15;
+
+    fn parse(d: &[u8]) -> Option<SlotRead> {
+        let (fixed, names) = d.split_at_checked(Self::FIXED)?;
+        let ok = names.len() % 6 == 0 && names.len() / 6 <= Self::MAX;
+        ok.then(|| SlotRead {
+            slot_ms: fixed[0],
+            param: fixed[1],
+            first_ms: fixed[2],
+            addresses: names
+                .chunks_exact(6)
+                .map(|c| Address(c.try_into().expect("6 bytes")))
+                .collect(),
+        })
+    }
+
+    /// The slot of `board`, if it is named.
+    pub fn slot_of(&self, board: &Address) -> Option<usize> {
+        self.addresses.iter().position(|a| a == board)
+    }
+
+    /// When `board` answers, µs after hearing the request; `None` when
+    /// it is not named.
+    pub fn reply_after(&self, board: &Address) -> Option<crate::time::Duration> {
+        let i = self.slot_of(board)? as u64;
+        Some((self.first_ms as u64 + i * self.slot_ms as u64) * crate::time::MS)
+    }
+}
+
 /// A service frame's payload, typed: requests and their replies.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum Service {
@@ -554,6 +631,8 @@ pub enum Service {
         /// Campaign to forget.
         campaign: u8,
     },
+    /// 13h: reads in slots.
+    ReadInSlots(SlotRead),
     /// A command whose layout is not described (user-defined commands
     /// this project does not know), kept as bytes.
     Raw {
@@ -668,6 +747,16 @@ impl Service {
                     }),
             };
         }
+        if command == READ_IN_SLOTS {
+            return SlotRead::parse(d)
+                .map(Service::ReadInSlots)
+                .ok_or(ServiceError::Length {
+                    name: desc.name,
+                    request: SlotRead::FIXED,
+                    reply: None,
+                    got: d.len(),
+                });
+        }
         let is_request = desc.request_len.is_none_or(|n| n == d.len());
         let is_reply = reply_len == Some(d.len());
         if !is_request && !is_reply {
@@ -777,6 +866,7 @@ impl Service {
             RfuSwap { .. } => 0x0e,
             RfuStatusGet { .. } | RfuStatus(_) => rfu::RFU_STATUS_GET,
             RfuAbort { .. } => rfu::RFU_ABORT,
+            ReadInSlots(_) => READ_IN_SLOTS,
             Raw { command, .. } => *command,
         }
     }
@@ -863,6 +953,12 @@ impl Service {
                 out.extend_from_slice(&crc.to_be_bytes());
             }
             RfuStatusGet { campaign } | RfuAbort { campaign } => out.push(*campaign),
+            ReadInSlots(r) => {
+                out.extend_from_slice(&[r.slot_ms, r.param, r.first_ms]);
+                for a in &r.addresses {
+                    out.extend_from_slice(&a.0);
+                }
+            }
             RfuStatus(s) => {
                 out.extend_from_slice(&[s.campaign, s.state, s.reason]);
                 out.extend_from_slice(&s.received.to_be_bytes());
@@ -918,6 +1014,18 @@ impl Service {
                     reply: None,
                     got: data.len(),
                 });
+            }
+        }
+        if let Service::ReadInSlots(r) = self {
+            if r.addresses.len() > SlotRead::MAX {
+                return Err(ServiceError::Field(FieldError {
+                    field: "addresses",
+                    reason: alloc::format!(
+                        "a request names at most {} boards, not {}",
+                        SlotRead::MAX,
+                        r.addresses.len()
+                    ),
+                }));
             }
         }
         if let Service::RfuData { data: segment, .. } = self {
