@@ -22,7 +22,7 @@ use crate::rng::Rng;
 use plm_core::app::concentrator::USART_IDLE;
 use plm_core::app::discovery::Responder;
 use plm_core::app::hid::{self, Hid};
-use plm_core::app::service::{Discovered, Release, Service, PARAM_LEN, SNR_MAX};
+use plm_core::app::service::{Discovered, Release, Service, SlotRead, PARAM_LEN, SNR_MAX};
 use plm_core::app::{
     Address, AppFrame, Clock, ErrorCode, FrameType, LineFrame, Message, UsartDecoder, UsartElement,
 };
@@ -588,6 +588,10 @@ impl Board {
                 ack
             }
             Service::SnGet => reply(Service::Sn(self.last_snr)),
+            Service::ReadInSlots(r) => {
+                self.read_in_slot(now, from, r);
+                None
+            }
             _ if broadcast => None,
             // Replies, and user commands this firmware does not know.
             _ => Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR)),
@@ -625,8 +629,36 @@ impl Board {
             },
         };
         if !broadcast {
-            self.hid_answers.push_back((at, from, answer));
+            self.queue_answer(at, from, answer);
         }
+    }
+
+    /// SERVICE_READ_IN_SLOTS (docs/protocol-notes.md, "Reads in slots"):
+    /// named at index i, the board asks its ballast for the parameter now
+    /// and sends its HID reply `first_ms + i × slot_ms` after hearing the
+    /// request, or nothing if the ballast is late or answers otherwise.
+    fn read_in_slot(&mut self, now: Instant, from: Address, r: &SlotRead) {
+        let (Some(after), Some(b)) = (r.reply_after(&self.address), self.ballast.as_mut()) else {
+            return;
+        };
+        let Some(a) = b.handle(now, &hid::ballast_frame(&Hid::Get(r.param).payload())) else {
+            return;
+        };
+        let due = now + after;
+        let Reply::Frame(f) = a.reply else {
+            return;
+        };
+        if let Some(h @ Hid::Reply { .. }) = hid::ballast_payload(&f).and_then(Hid::parse) {
+            if a.at <= due {
+                self.queue_answer(due, from, Message::Hid(h));
+            }
+        }
+    }
+
+    /// An answer due at `at`, kept in time order.
+    fn queue_answer(&mut self, at: Instant, to: Address, m: Message) {
+        let i = self.hid_answers.partition_point(|a| a.0 <= at);
+        self.hid_answers.insert(i, (at, to, m));
     }
 
     fn mib_answer(&mut self, now: Instant, data: Option<Vec<u8>>) {

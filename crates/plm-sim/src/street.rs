@@ -4,6 +4,7 @@
 //! way in ([`Attach`]). Tests and `cargo xtask bench` use it.
 
 use crate::sim::{Attach, Sim};
+use plm_core::app::read_all::ReadAll;
 use plm_core::app::{
     Address, AppEvent, Concentrator, Discovery, Happening, Message, Request, RequestId,
     RequesterConfig,
@@ -187,6 +188,36 @@ impl StreetDriver {
                 }
             }
         }
+    }
+
+    /// Reads `boards` in slots (plm-core's [`ReadAll`]): every request
+    /// it hands out is broadcast, every HID reply handed back to it.
+    /// Returns the finished read: what was heard, and the stragglers for
+    /// the caller to ask one by one.
+    pub fn read_in_slots(
+        &mut self,
+        boards: &[Address],
+        config: plm_core::app::read_all::ReadConfig,
+    ) -> ReadAll {
+        let (mut r, first) = ReadAll::start(self.sim.now(), boards, config);
+        if let Some(first) = first {
+            self.submit(first);
+        }
+        while !r.is_done() {
+            let until = r.poll_timeout().unwrap_or(self.sim.now());
+            for h in self.step(until) {
+                if let Happening::App(AppEvent::Unsolicited {
+                    address, message, ..
+                }) = h
+                {
+                    r.on_message(address, &message);
+                }
+            }
+            if let Some(next) = r.handle_timeout(self.sim.now()) {
+                self.submit(next);
+            }
+        }
+        r
     }
 
     /// Discovers the boards on the line (plm-core's rule); returns what
