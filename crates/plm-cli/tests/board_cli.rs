@@ -228,6 +228,10 @@ fn discover_status_and_dim_a_street() {
     read.sort();
     assert_eq!(read, (1..=3).map(lamp).collect::<Vec<_>>(), "{all:?}");
     assert!(all.err.contains("3 lamp(s) read, 0 silent"), "{}", all.err);
+    // Read in slots (docs/protocol-notes.md, "Reads in slots"), not one
+    // by one.
+    assert!(all.err.contains("reading them in slots"), "{}", all.err);
+    assert!(all.err.contains("3 heard in their slot"), "{}", all.err);
 
     let s = board(&mut server, &dir, "status", &["status", &lamp(2)]);
     assert_eq!(s.code, Some(0), "{s:?}");

@@ -9,6 +9,7 @@
 use super::Failure;
 use crate::port::Port;
 use plm_core::app::discovery::DiscoveryConfig;
+use plm_core::app::read_all::{ReadAll, ReadConfig};
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Message, Request,
     RequestId,
@@ -194,5 +195,33 @@ impl Driver {
             }
         }
         Ok(d)
+    }
+
+    /// Reads `boards` in slots (plm-core's [`ReadAll`]): every request it
+    /// hands out broadcast, every HID reply handed back to it. Returns the
+    /// finished read: what was heard, and the stragglers to ask one by one.
+    pub fn read_in_slots(
+        &mut self,
+        boards: &[Address],
+        config: ReadConfig,
+    ) -> Result<ReadAll, Failure> {
+        let (mut r, first) = ReadAll::start(self.now(), boards, config);
+        if let Some(first) = first {
+            self.submit(first)?;
+        }
+        while !r.is_done() {
+            for h in self.step(r.poll_timeout())? {
+                if let Happening::App(AppEvent::Unsolicited {
+                    address, message, ..
+                }) = h
+                {
+                    r.on_message(address, &message);
+                }
+            }
+            if let Some(next) = r.handle_timeout(self.now()) {
+                self.submit(next)?;
+            }
+        }
+        Ok(r)
     }
 }

@@ -5,6 +5,7 @@ use super::driver::Driver;
 use super::{exit, Failure, Target};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Ballast, Hid};
+use plm_core::app::read_all::ReadConfig;
 use plm_core::app::{Address, AppEvent, Message, Request, Service};
 use serde_json::{json, Map, Value};
 
@@ -55,19 +56,41 @@ pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u
 }
 
 /// `status all`: discovers the street, then reads every lamp found (its
-/// HID ballast parameters), one line (or JSON object) per lamp.
+/// HID ballast parameters) in slots (docs/protocol-notes.md, "Reads in
+/// slots"), the stragglers one by one; one line (or JSON object) per
+/// lamp.
 pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
     let started = std::time::Instant::now();
     tell!("plm board: discovering, then reading every lamp found");
     let found = d.discover(config, |_, _| {})?.found().to_vec();
     tell!(
-        "plm board: {} board(s) found in {:.1} s; reading them",
+        "plm board: {} board(s) found in {:.1} s; reading them in slots",
         found.len(),
         started.elapsed().as_secs_f64()
     );
+    let boards: Vec<Address> = found.iter().map(|(a, _)| *a).collect();
+    let read = ReadConfig {
+        timing: config.timing,
+        ..ReadConfig::ALL
+    };
+    let slots = d.read_in_slots(&boards, read)?;
+    let stragglers = slots.stragglers();
+    if !stragglers.is_empty() {
+        tell!(
+            "plm board: {} lamp(s) not heard in their slot; asking them one by one",
+            stragglers.len()
+        );
+    }
     let mut silent = 0;
     for (address, info) in &found {
-        let got = refused(d.ask(*address, Message::Hid(Hid::Get(hid::ALL)))?);
+        let heard = slots.heard().iter().find(|(a, _)| a == address);
+        let got = match heard {
+            Some((_, value)) => Ok(Message::Hid(Hid::Reply {
+                param: hid::ALL,
+                value: value.clone(),
+            })),
+            None => refused(d.ask(*address, Message::Hid(Hid::Get(hid::ALL)))?),
+        };
         let lamp = match &got {
             Ok(Message::Hid(Hid::Reply { param, value })) if *param == hid::ALL => {
                 Ballast::decode(value).ok_or_else(|| String::from("a short ballast reply"))
@@ -104,9 +127,10 @@ pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result
         }
     }
     tell!(
-        "plm board: {} lamp(s) read, {silent} silent, in {:.1} s",
+        "plm board: {} lamp(s) read, {silent} silent, in {:.1} s; {} heard in their slot",
         found.len() - silent,
-        started.elapsed().as_secs_f64()
+        started.elapsed().as_secs_f64(),
+        slots.heard().len()
     );
     Ok(if found.is_empty() || silent > 0 {
         exit::FAILED
