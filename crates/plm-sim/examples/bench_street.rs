@@ -3,7 +3,8 @@
 //!
 //! 1. Discovering and reading streets of 12, 100 and 500 lamps through
 //!    the concentrator board's USART (`StreetDriver::discover`, then
-//!    `Hid::Get(ALL)` for every lamp, one after another), in simulated
+//!    `Hid::Get(ALL)` of every lamp found in slots,
+//!    `StreetDriver::read_in_slots`, the stragglers one by one), in simulated
 //!    seconds, against the channel limit: the airtime, at the modulation
 //!    in use (B-PSK, factory PHY_Config), of every frame that must cross
 //!    the line — the discovery broadcast, each lamp's discovery reply and
@@ -24,8 +25,9 @@
 
 use plm_core::app::discovery::{DiscoveryConfig, Timing};
 use plm_core::app::hid::{self, Hid};
+use plm_core::app::read_all::ReadConfig;
 use plm_core::app::service::{Discovered, Release, Service};
-use plm_core::app::{LineFrame, Message, RequesterConfig};
+use plm_core::app::{Address, LineFrame, Message, RequesterConfig};
 use plm_core::st7580::mib::{index, object, PhyConfig};
 use plm_core::st7580::{Modulation, TxParams};
 use plm_core::time::{Duration, MS};
@@ -61,6 +63,33 @@ fn read_all(d: &mut StreetDriver, lamps: usize, step: usize) -> (Vec<Message>, u
         }
     }
     (replies, failed)
+}
+
+/// Reads the all-parameters of `boards` in slots (SERVICE_READ_IN_SLOTS,
+/// `StreetDriver::read_in_slots`), then the stragglers one after another;
+/// returns the replies, how many were stragglers and how many reads
+/// failed.
+fn read_in_slots(d: &mut StreetDriver, boards: &[Address]) -> (Vec<Message>, usize, usize) {
+    let r = d.read_in_slots(boards, ReadConfig::ALL);
+    let mut replies: Vec<Message> = r
+        .heard()
+        .iter()
+        .map(|(_, value)| {
+            Message::Hid(Hid::Reply {
+                param: hid::ALL,
+                value: value.clone(),
+            })
+        })
+        .collect();
+    let stragglers = r.stragglers();
+    let mut failed = 0;
+    for a in &stragglers {
+        match d.ask(*a, Message::Hid(Hid::Get(hid::ALL)), 60 * S) {
+            Ok(m @ Message::Hid(Hid::Reply { .. })) => replies.push(m),
+            _ => failed += 1,
+        }
+    }
+    (replies, stragglers.len(), failed)
 }
 
 /// Airtime of one application message as a line frame: the line frame's
@@ -199,7 +228,8 @@ fn discover_and_read(lamps: usize) {
     let wall = Instant::now();
     let found = d.discover(DiscoveryConfig::new(1, lamps));
     let discovered = d.now() - start;
-    let (replies, failed) = read_all(&mut d, lamps, 1);
+    let boards: Vec<Address> = found.keys().copied().collect();
+    let (replies, stragglers, failed) = read_in_slots(&mut d, &boards);
     let took = (d.now() - start) as f64 / 1e6;
     let wall = wall.elapsed().as_secs_f64();
 
@@ -228,7 +258,7 @@ fn discover_and_read(lamps: usize) {
     println!(
         "street discover+read {lamps} lamps: {took:.1} s simulated, channel limit {limit:.1} s, \
          ratio {:.2} (discovery {:.1} s, {} of {lamps} found; \
-         {} read, {failed} failed; {wall:.2} s wall)",
+         {} read in slots ({stragglers} stragglers one by one), {failed} failed; {wall:.2} s wall)",
         limit / took,
         discovered as f64 / 1e6,
         found.len(),
