@@ -117,3 +117,31 @@ fn a_board_not_named_stays_silent_and_one_named_answers_in_its_slot() {
         "{gap} µs apart"
     );
 }
+
+#[test]
+fn a_board_whose_ballast_is_late_for_its_slot_stays_silent() {
+    let mut d = street(3, 6);
+    // Slot 0 begins as the request is heard: the ballast (5 ms) is late
+    // for it; slot 1, 62 ms later, is not.
+    let read = SlotRead {
+        slot_ms: ReadConfig::ALL.slot_ms(),
+        param: hid::ALL,
+        first_ms: 0,
+        addresses: vec![street_address(2), street_address(3)],
+    };
+    d.submit(Request::all(Message::Service(Service::ReadInSlots(read))));
+    d.run_for(2 * S);
+    let from: Vec<Address> = d
+        .log
+        .iter()
+        .filter_map(|(_, h)| match h {
+            plm_core::app::Happening::App(plm_core::app::AppEvent::Unsolicited {
+                address,
+                message: Message::Hid(Hid::Reply { .. }),
+                ..
+            }) => Some(*address),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(from, [street_address(3)]);
+}
