@@ -31,7 +31,7 @@ SERVICE = {
     0x0C: "SERVICE_RFU_SET_IMG_HEADER", 0x0D: "SERVICE_RFU_SET_IMG_DATA",
     0x0E: "SERVICE_RFU_SWAP_IMG",
     # User-defined (4.5: "0x0b to 0x7f"), this project's (protocol notes).
-    0x11: "RFU_STATUS_GET", 0x12: "RFU_ABORT",
+    0x11: "RFU_STATUS_GET", 0x12: "RFU_ABORT", 0x13: "SERVICE_READ_IN_SLOTS",
 }
 PROG_GRP_USER_DATA = 0x02
 
@@ -160,6 +160,17 @@ D = "project decision (docs/protocol-notes.md); seed 4.5 names 0Bh only"
 v("SERVICE_NET_DISCOVER_REQ request", D, 13,
   [13, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B, 5, 10],
   svc(0x0B, "request", {"session": 5, "window": 10}, broadcast=True))
+# Rule 2 (slotted frames): [2, session, frame, slots, slot ms, share,
+# addresses heard...]; and the request as the seed lists it, with no data.
+LAMP1 = [0x00, 0x80, 0xE1, 0x00, 0x00, 0x01]
+LAMP2 = [0x00, 0x80, 0xE1, 0x00, 0x00, 0x02]
+v("SERVICE_NET_DISCOVER_REQ request, rule 2", D, 23,
+  [23, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B, 2, 5, 0, 16, 33, 255, *LAMP1],
+  svc(0x0B, "request", {"rule": 2, "session": 5, "frame": 0, "slots": 16, "slot_ms": 33,
+                        "share": 255, "heard": bytes(LAMP1).hex()}, broadcast=True))
+v("SERVICE_NET_DISCOVER_REQ request, bare", D, 11,
+  [11, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B],
+  svc(0x0B, "request", {}, broadcast=True))
 v("SERVICE_NET_DISCOVER_REQ reply", D, 16,
   [16, APP_SERVICE_FRAME, *ADDR, 0x0B, 1, 2, 3, 4, 20],
   svc(0x0B, "reply", {"firmware_major": 1, "firmware_minor": 2, "stack_major": 3,
@@ -208,6 +219,13 @@ v("RFU_ABORT request", R, 12,
   [12, APP_SERVICE_FRAME, *ADDR, 0x12, CAMPAIGN], svc(0x12, "request", {"campaign": CAMPAIGN}))
 v("RFU_ABORT ACK", R, 12,
   [12, APP_ACK_FRAME, *ADDR, APP_SERVICE_FRAME, 0x12], ack(APP_SERVICE_FRAME, 0x12))
+
+# SERVICE_READ_IN_SLOTS (13h, user-defined): [slot ms, HID param, first
+# slot ms, addresses...]; the boards answer with HID replies.
+v("SERVICE_READ_IN_SLOTS request", R, 26,
+  [26, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x13, 62, 0x0A, 20, *LAMP1, *LAMP2],
+  svc(0x13, "request", {"slot_ms": 62, "param": 10, "first_ms": 20,
+                        "addresses": bytes(LAMP1 + LAMP2).hex()}, broadcast=True))
 
 # 4.6.2 Ping frames and their ACK (the ping's command echo: 0, protocol notes).
 P = "STEVAL-IHP007V1 UM 4.6.2 Ping frames"

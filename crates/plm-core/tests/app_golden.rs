@@ -8,7 +8,9 @@
 use plm_core::app::crc::{crc16, SEED_TABLE_TYPOS};
 use plm_core::app::hid::{self, Hid};
 use plm_core::app::rfu;
-use plm_core::app::service::{self, Answer, Clock, Discovered, Release, Service};
+use plm_core::app::service::{
+    self, Answer, Clock, Discovered, Release, Service, SlotFrame, SlotRead,
+};
 use plm_core::app::{Address, AppFrame, ErrorCode, FrameType, Message};
 use plm_core::decode_app::decode_usart;
 use serde_json::Value;
@@ -213,6 +215,21 @@ fn typed(name: &str) -> Option<Message> {
             session: 5,
             window: 10,
         }),
+        "SERVICE_NET_DISCOVER_REQ request, rule 2" => s(DiscoverFrame(SlotFrame {
+            session: 5,
+            frame: 0,
+            slots: 16,
+            slot_ms: 33,
+            share: 255,
+            heard: vec![lamp(1)],
+        })),
+        "SERVICE_NET_DISCOVER_REQ request, bare" => s(DiscoverAny),
+        "SERVICE_READ_IN_SLOTS request" => s(ReadInSlots(SlotRead {
+            slot_ms: 62,
+            param: 0x0A,
+            first_ms: 20,
+            addresses: vec![lamp(1), lamp(2)],
+        })),
         "SERVICE_NET_DISCOVER_REQ reply" => s(DiscoverReply(Discovered {
             firmware: Release { major: 1, minor: 2 },
             stack: Release { major: 3, minor: 4 },
@@ -522,4 +539,9 @@ fn a_whole_capture_of_the_vectors_decodes_frame_by_frame() {
         assert_eq!(g.hex, plm_core::hex::encode(&v.bytes), "{}", v.name);
         assert_eq!(g.crc_ok, Some(true), "{}", v.name);
     }
+}
+
+/// Lamp `n` of the vectors (0080E10000nnh).
+fn lamp(n: u8) -> Address {
+    Address([0x00, 0x80, 0xE1, 0x00, 0x00, n])
 }
