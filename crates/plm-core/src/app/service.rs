@@ -460,21 +460,30 @@ impl SlotFrame {
     };
 
     fn parse(d: &[u8]) -> Option<SlotFrame> {
-        let (fixed, heard) = d.split_at_checked(Self::FIXED)?;
-        let ok =
-            fixed[0] == Self::RULE && heard.len() % 6 == 0 && heard.len() / 6 <= Self::MAX_HEARD;
-        ok.then(|| SlotFrame {
+        let (fixed, heard) = fixed_then_addresses(d, Self::FIXED, Self::MAX_HEARD)?;
+        (fixed[0] == Self::RULE).then(|| SlotFrame {
             session: fixed[1],
             frame: fixed[2],
             slots: fixed[3],
             slot_ms: fixed[4],
             share: fixed[5],
-            heard: heard
-                .chunks_exact(6)
-                .map(|c| Address(c.try_into().expect("6 bytes")))
-                .collect(),
+            heard,
         })
     }
+}
+
+/// `fixed` bytes, then at most `most` six-byte addresses: the layout of
+/// the slotted requests (0Bh rule 2, 13h).
+fn fixed_then_addresses(d: &[u8], fixed: usize, most: usize) -> Option<(&[u8], Vec<Address>)> {
+    let (head, rest) = d.split_at_checked(fixed)?;
+    let fits = rest.len() % 6 == 0 && rest.len() / 6 <= most;
+    fits.then(|| {
+        let addresses = rest
+            .chunks_exact(6)
+            .map(|c| Address(c.try_into().expect("6 bytes")))
+            .collect();
+        (head, addresses)
+    })
 }
 
 /// A SERVICE_READ_IN_SLOTS request (docs/protocol-notes.md, "Reads in
@@ -501,16 +510,12 @@ impl SlotRead {
     pub const MAX: usize = 15;
 
     fn parse(d: &[u8]) -> Option<SlotRead> {
-        let (fixed, names) = d.split_at_checked(Self::FIXED)?;
-        let ok = names.len() % 6 == 0 && names.len() / 6 <= Self::MAX;
-        ok.then(|| SlotRead {
+        let (fixed, addresses) = fixed_then_addresses(d, Self::FIXED, Self::MAX)?;
+        Some(SlotRead {
             slot_ms: fixed[0],
             param: fixed[1],
             first_ms: fixed[2],
-            addresses: names
-                .chunks_exact(6)
-                .map(|c| Address(c.try_into().expect("6 bytes")))
-                .collect(),
+            addresses,
         })
     }
 
