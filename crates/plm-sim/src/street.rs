@@ -6,7 +6,7 @@
 use crate::sim::{Attach, Sim};
 use plm_core::app::read_all::ReadAll;
 use plm_core::app::{
-    Address, AppEvent, Concentrator, Discovery, Happening, Message, Request, RequestId,
+    Address, AppEvent, Concentrator, Discovery, Happening, Listener, Message, Request, RequestId,
     RequesterConfig,
 };
 use plm_core::link::host::Transmit;
@@ -203,21 +203,29 @@ impl StreetDriver {
         if let Some(first) = first {
             self.submit(first);
         }
-        while !r.is_done() {
-            let until = r.poll_timeout().unwrap_or(self.sim.now());
+        self.listen(&mut r);
+        r
+    }
+
+    /// Runs `engine` to its end: what boards send unasked handed to it,
+    /// what it hands out sent.
+    fn listen(&mut self, engine: &mut impl Listener) {
+        while !engine.done() {
+            let until = engine.due().unwrap_or(self.sim.now());
             for h in self.step(until) {
                 if let Happening::App(AppEvent::Unsolicited {
                     address, message, ..
                 }) = h
                 {
-                    r.on_message(address, &message);
+                    if let Some(answer) = engine.hear(address, &message) {
+                        self.send(answer);
+                    }
                 }
             }
-            if let Some(next) = r.handle_timeout(self.sim.now()) {
+            if let Some(next) = engine.tick(self.sim.now()) {
                 self.submit(next);
             }
         }
-        r
     }
 
     /// Discovers the boards on the line (plm-core's rule); returns what
@@ -228,22 +236,7 @@ impl StreetDriver {
     ) -> BTreeMap<Address, plm_core::app::Discovered> {
         let (mut d, first) = Discovery::start(self.sim.now(), config);
         self.submit(first);
-        while !d.is_done() {
-            let until = d.poll_timeout().unwrap_or(self.sim.now());
-            for h in self.step(until) {
-                if let Happening::App(AppEvent::Unsolicited {
-                    address, message, ..
-                }) = h
-                {
-                    if let Some(ack) = d.on_message(address, &message) {
-                        self.send(ack);
-                    }
-                }
-            }
-            if let Some(next) = d.handle_timeout(self.sim.now()) {
-                self.submit(next);
-            }
-        }
+        self.listen(&mut d);
         d.found().iter().copied().collect()
     }
 }

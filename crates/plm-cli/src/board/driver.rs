@@ -11,8 +11,8 @@ use crate::port::Port;
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::read_all::{ReadAll, ReadConfig};
 use plm_core::app::{
-    Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Message, Request,
-    RequestId,
+    Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Listener, Message,
+    Request, RequestId,
 };
 use plm_core::link::host::Transmit;
 use plm_core::time::Instant;
@@ -173,27 +173,13 @@ impl Driver {
     ) -> Result<Discovery, Failure> {
         let (mut d, first) = Discovery::start(self.now(), config);
         self.submit(first)?;
-        while !d.is_done() {
-            for h in self.step(d.poll_timeout())? {
-                if let Happening::App(AppEvent::Unsolicited {
-                    address, message, ..
-                }) = h
-                {
-                    let before = d.found().len();
-                    if let Some(ack) = d.on_message(address, &message) {
-                        self.send(ack)?;
-                    }
-                    if d.found().len() > before {
-                        if let Some((a, info)) = d.found().last() {
-                            found(*a, *info);
-                        }
-                    }
-                }
+        let mut told = 0;
+        self.listen(&mut d, |d| {
+            for (a, info) in &d.found()[told..] {
+                found(*a, *info);
             }
-            if let Some(next) = d.handle_timeout(self.now()) {
-                self.submit(next)?;
-            }
-        }
+            told = d.found().len();
+        })?;
         Ok(d)
     }
 
@@ -209,19 +195,33 @@ impl Driver {
         if let Some(first) = first {
             self.submit(first)?;
         }
-        while !r.is_done() {
-            for h in self.step(r.poll_timeout())? {
+        self.listen(&mut r, |_| {})?;
+        Ok(r)
+    }
+
+    /// Runs `engine` to its end: what boards send unasked handed to it
+    /// (and `heard` called after each), what it hands out sent.
+    fn listen<L: Listener>(
+        &mut self,
+        engine: &mut L,
+        mut heard: impl FnMut(&L),
+    ) -> Result<(), Failure> {
+        while !engine.done() {
+            for h in self.step(engine.due())? {
                 if let Happening::App(AppEvent::Unsolicited {
                     address, message, ..
                 }) = h
                 {
-                    r.on_message(address, &message);
+                    if let Some(answer) = engine.hear(address, &message) {
+                        self.send(answer)?;
+                    }
+                    heard(engine);
                 }
             }
-            if let Some(next) = r.handle_timeout(self.now()) {
+            if let Some(next) = engine.tick(self.now()) {
                 self.submit(next)?;
             }
         }
-        Ok(r)
+        Ok(())
     }
 }
