@@ -32,6 +32,7 @@ pub mod read_all;
 pub mod requester;
 pub mod rfu;
 pub mod service;
+pub mod sweep;
 pub mod update;
 pub mod usart;
 
