@@ -9,7 +9,7 @@
 use super::Failure;
 use crate::port::Port;
 use plm_core::app::discovery::DiscoveryConfig;
-use plm_core::app::read_all::{ReadAll, ReadConfig};
+use plm_core::app::sweep::Round;
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Listener, Message,
     Request, RequestId,
@@ -183,20 +183,43 @@ impl Driver {
         Ok(d)
     }
 
-    /// Reads `boards` in slots (plm-core's [`ReadAll`]): every request it
-    /// hands out broadcast, every HID reply handed back to it. Returns the
-    /// finished read: what was heard, and the stragglers to ask one by one.
-    pub fn read_in_slots(
-        &mut self,
-        boards: &[Address],
-        config: ReadConfig,
-    ) -> Result<ReadAll, Failure> {
-        let (mut r, first) = ReadAll::start(self.now(), boards, config);
-        if let Some(first) = first {
-            self.submit(first)?;
+    /// Runs a round of reads (plm-core's [`Round`]) to its end: each
+    /// request it gives sent, the fate of each unicast one and what boards
+    /// send unasked handed back; what was read stays in it.
+    pub fn run_round(&mut self, round: &mut Round) -> Result<(), Failure> {
+        let mut asked = None;
+        while !round.is_done() {
+            if asked.is_none() {
+                if let Some(q) = round.poll(self.now()) {
+                    let unicast = !q.broadcast;
+                    let id = self.submit(q)?;
+                    asked = unicast.then_some(id);
+                    continue;
+                }
+            }
+            for h in self.step(round.poll_timeout())? {
+                let Happening::App(e) = h else { continue };
+                match e {
+                    AppEvent::Unsolicited {
+                        address, message, ..
+                    } => {
+                        if let Some(answer) = round.hear(address, &message) {
+                            self.send(answer)?;
+                        }
+                    }
+                    AppEvent::Answered { id, answer, .. } if Some(id) == asked => {
+                        asked = None;
+                        round.on_answer(Ok(answer));
+                    }
+                    AppEvent::Failed { id, reason, .. } if Some(id) == asked => {
+                        asked = None;
+                        round.on_answer(Err(reason));
+                    }
+                    _ => {}
+                }
+            }
         }
-        self.listen(&mut r, |_| {})?;
-        Ok(r)
+        Ok(())
     }
 
     /// Runs `engine` to its end: what boards send unasked handed to it

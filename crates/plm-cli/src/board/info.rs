@@ -6,8 +6,10 @@ use super::{exit, Failure, Target};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Ballast, Hid};
 use plm_core::app::read_all::ReadConfig;
+use plm_core::app::sweep::{Known, Reading, Round, RoundConfig};
 use plm_core::app::{Address, AppEvent, Message, Request, Service};
 use serde_json::{json, Map, Value};
+use std::collections::BTreeMap;
 
 /// Discovers the boards; prints each as it is found.
 pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
@@ -56,49 +58,60 @@ pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u
 }
 
 /// `status all`: discovers the street, then reads every lamp found (its
-/// HID ballast parameters) in slots (docs/protocol-notes.md, "Reads in
-/// slots"), the stragglers one by one; one line (or JSON object) per
-/// lamp.
+/// HID ballast parameters) with plm-core's round of reads
+/// (docs/board-protocol.md, "A round of reads"): in slots, the stragglers
+/// one by one; one line (or JSON object) per lamp.
 pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
     let started = std::time::Instant::now();
     tell!("plm board: discovering, then reading every lamp found");
     let found = d.discover(config, |_, _| {})?.found().to_vec();
-    tell!(
-        "plm board: {} board(s) found in {:.1} s; reading them in slots",
-        found.len(),
-        started.elapsed().as_secs_f64()
-    );
-    let boards: Vec<Address> = found.iter().map(|(a, _)| *a).collect();
-    let read = ReadConfig {
-        timing: config.timing,
-        ..ReadConfig::ALL
+    let reads = RoundConfig {
+        read: ReadConfig {
+            timing: config.timing,
+            ..ReadConfig::ALL
+        },
+        ..RoundConfig::READS
     };
-    let slots = d.read_in_slots(&boards, read)?;
-    let stragglers = slots.stragglers();
-    if !stragglers.is_empty() {
-        tell!(
-            "plm board: {} lamp(s) not heard in their slot; asking them one by one",
-            stragglers.len()
-        );
+    tell!(
+        "plm board: {} board(s) found in {:.1} s; reading them {}",
+        found.len(),
+        started.elapsed().as_secs_f64(),
+        if found.len() < reads.slots_from {
+            "one by one"
+        } else {
+            "in slots, the lamps not heard in theirs one by one"
+        }
+    );
+    // Discovery has just given every SNR: no lamp is asked it.
+    let now = d.now();
+    let lamps = found
+        .iter()
+        .map(|(address, info)| Known {
+            address: *address,
+            discovered: Some(*info),
+            snr_at: Some(now),
+        })
+        .collect();
+    let mut round = Round::new(lamps, reads);
+    d.run_round(&mut round)?;
+    let mut got = BTreeMap::new();
+    while let Some(r) = round.poll_reading() {
+        match r {
+            Reading::Value(a, value) => got.insert(a, Ok(value)),
+            Reading::Failed(a, why) => got.insert(a, Err(why)),
+            _ => None,
+        };
     }
     let mut silent = 0;
     for (address, info) in &found {
-        let heard = slots.heard().iter().find(|(a, _)| a == address);
-        let got = match heard {
-            Some((_, value)) => Ok(Message::Hid(Hid::Reply {
-                param: hid::ALL,
-                value: value.clone(),
-            })),
-            None => refused(d.ask(*address, Message::Hid(Hid::Get(hid::ALL)))?),
-        };
-        let lamp = match &got {
-            Ok(Message::Hid(Hid::Reply { param, value })) if *param == hid::ALL => {
-                Ballast::decode(value).ok_or_else(|| String::from("a short ballast reply"))
+        let lamp = match got.remove(address) {
+            Some(Ok(value)) => {
+                Ballast::decode(&value).ok_or_else(|| String::from("a short ballast reply"))
             }
-            Ok(other) => Err(format!("answered {other:?}")),
-            Err(why) => Err(why.clone()),
+            Some(Err(why)) => Err(why),
+            None => Err(String::from("not read")),
         };
-        silent += usize::from(got.is_err());
+        silent += usize::from(lamp.is_err());
         if json {
             let mut o = json!({
                 "address": address.to_string(),
@@ -130,7 +143,7 @@ pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result
         "plm board: {} lamp(s) read, {silent} silent, in {:.1} s; {} heard in their slot",
         found.len() - silent,
         started.elapsed().as_secs_f64(),
-        slots.heard().len()
+        round.in_slots()
     );
     Ok(if found.is_empty() || silent > 0 {
         exit::FAILED
