@@ -3,7 +3,7 @@
 //! all` both do. Every lamp's HID parameter is read in slots
 //! ([`ReadAll`], SERVICE_READ_IN_SLOTS 13h) when there are enough lamps
 //! to pay for the request, the lamps not heard are asked one by one (a
-//! unicast `'g' param`, UM 4.6), then SERVICE_SN_GET (10h, UM 4.5) goes
+//! unicast `'g' param`, UM Appendix A), then SERVICE_SN_GET (10h, UM 4.5) goes
 //! to the lamps whose SNR figure is oldest, and last, if asked, one
 //! discovery frame of the session the lamps were heard in asks whether
 //! anyone is new.
@@ -36,7 +36,8 @@ pub const SLOTS_FROM: usize = 3;
 pub struct Known {
     /// Its board's address.
     pub address: Address,
-    /// What discovery heard of it: the probe names it, so it stays quiet.
+    /// What discovery heard of it (heard in the probe's session, it stays
+    /// quiet; heard again, it restarted and is not new).
     pub discovered: Option<Discovered>,
     /// When its SNR figure was got (`None`: never).
     pub snr_at: Option<Instant>,
