@@ -95,7 +95,7 @@ pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result
     let mut round = Round::new(lamps, reads);
     d.run_round(&mut round)?;
     let mut got = BTreeMap::new();
-    while let Some(r) = round.poll_reading() {
+    for r in round.take_readings() {
         match r {
             Reading::Value(a, value) => got.insert(a, Ok(value)),
             Reading::Failed(a, why) => got.insert(a, Err(why)),

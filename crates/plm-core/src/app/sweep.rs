@@ -10,7 +10,7 @@
 //! Sans-IO: the caller sends each request [`Round::poll`] gives it, hands
 //! back the fate of each unicast one ([`Round::on_answer`]) and what
 //! boards send unasked ([`Round::hear`]), and takes what was read
-//! ([`Round::poll_reading`]).
+//! ([`Round::take_readings`]).
 
 use super::discovery::{Discovery, DiscoveryConfig};
 use super::frame::{Address, AppFrame};
@@ -119,7 +119,7 @@ pub struct Round {
     /// Lamps to ask alone, and the request under way.
     queue: VecDeque<Address>,
     asked: Option<(Address, Ask)>,
-    readings: VecDeque<Reading>,
+    readings: Vec<Reading>,
     /// Lamps whose read ended (a value or a failure), heard in slots.
     settled: usize,
     in_slots: usize,
@@ -136,7 +136,7 @@ impl Round {
             step: Step::Start,
             queue: VecDeque::new(),
             asked: None,
-            readings: VecDeque::new(),
+            readings: Vec::new(),
             settled: 0,
             in_slots: 0,
             failed: Vec::new(),
@@ -234,9 +234,17 @@ impl Round {
             .filter(|l| l.snr_at.is_none_or(|t| now.saturating_sub(t) > after))
             .filter(|l| !self.failed.contains(&l.address))
             .collect();
-        stale.sort_by_key(|l| l.snr_at);
         let most = self.lamps.len().div_ceil(self.config.snr_one_in.max(1));
-        stale.iter().take(most).map(|l| l.address).collect()
+        // The oldest, one after another (a missing figure is older than
+        // any): no sort, which would cost the console its code.
+        let mut wanted = Vec::new();
+        while wanted.len() < most {
+            let Some(i) = (0..stale.len()).min_by_key(|&i| stale[i].snr_at) else {
+                break;
+            };
+            wanted.push(stale.swap_remove(i).address);
+        }
+        wanted
     }
 
     /// A frame that came unasked: a lamp's reply in its slot, or a
@@ -250,8 +258,7 @@ impl Round {
                     if let Message::Hid(Hid::Reply { value, .. }) = message {
                         self.settled += 1;
                         self.in_slots += 1;
-                        self.readings
-                            .push_back(Reading::Value(address, value.clone()));
+                        self.readings.push(Reading::Value(address, value.clone()));
                     }
                 }
                 None
@@ -260,7 +267,7 @@ impl Round {
                 let ack = d.on_message(address, message);
                 if let Message::Service(Service::DiscoverReply(r)) = message {
                     self.new_heard |= !self.lamps.iter().any(|l| l.address == address);
-                    self.readings.push_back(Reading::Heard(address, *r));
+                    self.readings.push(Reading::Heard(address, *r));
                 }
                 ack
             }
@@ -294,12 +301,12 @@ impl Round {
             self.failed.push(a);
         }
         self.settled += usize::from(ask == Ask::Read);
-        self.readings.push_back(reading);
+        self.readings.push(reading);
     }
 
-    /// What was learned, in the order it came.
-    pub fn poll_reading(&mut self) -> Option<Reading> {
-        self.readings.pop_front()
+    /// What was learned since the last call, in the order it came.
+    pub fn take_readings(&mut self) -> Vec<Reading> {
+        core::mem::take(&mut self.readings)
     }
 
     /// When [`Round::poll`] is due for time (a window or a probe frame
@@ -376,7 +383,7 @@ mod tests {
     }
 
     fn readings(r: &mut Round) -> Vec<Reading> {
-        core::iter::from_fn(|| r.poll_reading()).collect()
+        r.take_readings()
     }
 
     /// 40 lamps: three requests in slots, where 7 and 33 stay silent;
@@ -416,7 +423,8 @@ mod tests {
             t = r.poll_timeout().expect("a window");
             q = r.poll(t).expect("the next request");
         }
-        assert_eq!(slot_requests, 3);
+        // Forty boards sharing five address bytes: one request names them.
+        assert_eq!(slot_requests, 1);
         assert_eq!((r.settled(), r.in_slots()), (38, 38));
         let heard = readings(&mut r);
         assert_eq!(heard.len(), 38);
