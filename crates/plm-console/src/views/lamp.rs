@@ -115,12 +115,6 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     let street = use_console().street;
     let note = signal(None::<String>);
     let level = signal(String::from("50"));
-    let lamp = Memo::new(move |_| {
-        street.version.track();
-        focus
-            .get()
-            .and_then(|a| street.with_fleet(|f| f.get(&a).cloned()))
-    });
     // u32 signals (a type the page has) holding bytes.
     let io_config = signal(0u32);
     let outputs = signal(0u32);
@@ -178,7 +172,14 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             <h3>{format!("Lamp {address}")}</h3>
                             {button("lamp-close", "✕", "close this lamp's page", move || focus.set(None))}
                         </div>
-                        {html(Box::new(move || lamp.with(|l| state_html(l.as_ref()))))}
+                        // Read in place at each change of the fleet, not
+                        // through a memo of the lamp (a memo type of its own:
+                        // 1.8 KiB of the page); the HTML is written only when
+                        // it differs.
+                        {html(Box::new(move || {
+                            street.version.track();
+                            street.with_fleet(|f| state_html(f.get(&address)))
+                        }))}
                         <div class="form-row">
                             {button("lamp-read", "Read now", "", move || ask(Message::Hid(plm_core::app::Hid::Get(plm_core::app::hid::ALL)), "read"))}
                             <label>
