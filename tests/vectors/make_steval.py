@@ -161,13 +161,17 @@ v("SERVICE_NET_DISCOVER_REQ request", D, 13,
   [13, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B, 5, 10],
   svc(0x0B, "request", {"session": 5, "window": 10}, broadcast=True))
 # Rule 2 (slotted frames): [2, session, frame, slots, slot ms, share,
-# addresses heard...]; and the request as the seed lists it, with no data.
+# names of the boards heard]; and the request as the seed lists it, with no
+# data. Names (docs/protocol-notes.md): [p, the p bytes every address
+# starts with, the other 6 - p bytes of each].
 LAMP1 = [0x00, 0x80, 0xE1, 0x00, 0x00, 0x01]
 LAMP2 = [0x00, 0x80, 0xE1, 0x00, 0x00, 0x02]
-v("SERVICE_NET_DISCOVER_REQ request, rule 2", D, 23,
-  [23, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B, 2, 5, 0, 16, 33, 255, *LAMP1],
+NAMES = [5, *LAMP1[:5], LAMP1[5], LAMP2[5]]
+v("SERVICE_NET_DISCOVER_REQ request, rule 2", D, 25,
+  [25, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B, 2, 5, 0, 16, 33, 255, *NAMES],
   svc(0x0B, "request", {"rule": 2, "session": 5, "frame": 0, "slots": 16, "slot_ms": 33,
-                        "share": 255, "heard": bytes(LAMP1).hex()}, broadcast=True))
+                        "share": 255, "shared": 5, "heard": bytes(NAMES[1:]).hex()},
+      broadcast=True))
 v("SERVICE_NET_DISCOVER_REQ request, bare", D, 11,
   [11, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x0B],
   svc(0x0B, "request", {}, broadcast=True))
@@ -221,11 +225,11 @@ v("RFU_ABORT ACK", R, 12,
   [12, APP_ACK_FRAME, *ADDR, APP_SERVICE_FRAME, 0x12], ack(APP_SERVICE_FRAME, 0x12))
 
 # SERVICE_READ_IN_SLOTS (13h, user-defined): [slot ms, HID param, first
-# slot ms, addresses...]; the boards answer with HID replies.
-v("SERVICE_READ_IN_SLOTS request", R, 26,
-  [26, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x13, 62, 0x0A, 20, *LAMP1, *LAMP2],
-  svc(0x13, "request", {"slot_ms": 62, "param": 10, "first_ms": 20,
-                        "addresses": bytes(LAMP1 + LAMP2).hex()}, broadcast=True))
+# slot ms, names of the boards]; the boards answer with HID replies.
+v("SERVICE_READ_IN_SLOTS request", R, 22,
+  [22, APP_SERVICE_FRAME | BROADCAST_FLAG, *ADDR, 0x13, 62, 0x0A, 20, *NAMES],
+  svc(0x13, "request", {"slot_ms": 62, "param": 10, "first_ms": 20, "shared": 5,
+                        "addresses": bytes(NAMES[1:]).hex()}, broadcast=True))
 
 # 4.6.2 Ping frames and their ACK (the ping's command echo: 0, protocol notes).
 P = "STEVAL-IHP007V1 UM 4.6.2 Ping frames"

@@ -221,7 +221,7 @@ fn typed(name: &str) -> Option<Message> {
             slots: 16,
             slot_ms: 33,
             share: 255,
-            heard: vec![lamp(1)],
+            heard: vec![lamp(1), lamp(2)],
         })),
         "SERVICE_NET_DISCOVER_REQ request, bare" => s(DiscoverAny),
         "SERVICE_READ_IN_SLOTS request" => s(ReadInSlots(SlotRead {

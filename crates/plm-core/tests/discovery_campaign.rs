@@ -92,18 +92,29 @@ fn run(boards: usize, guess: usize, line: Line, seed: u64) -> (usize, u8, f64) {
                 );
             }
         }
-        let now = d.poll_timeout().expect("a frame is running");
         if trace {
             let heard = slots.iter().filter(|s| s.len() == 1).count();
             println!(
-                "frame {} slots {} share {} others {} named {} found {} left {:.1} singles {heard} at {:.2}",
-                d.frames(), d.plan().slots, d.plan().share, d.plan().others, frame.heard.len(), d.found().len(), d.left(), now as f64 / 1e6
+                "frame {} slots {} share {} others {} named {} found {} left {:.1} singles {heard}",
+                d.frames(),
+                d.plan().slots,
+                d.plan().share,
+                d.plan().others,
+                frame.heard.len(),
+                d.found().len(),
+                d.left()
             );
         }
-        match d.handle_timeout(now) {
-            Some(r) => request = r,
-            None => return (d.found().len(), d.frames(), now as f64 / 1e6),
-        }
+        // The next request, or the end (a frame that ends the discovery
+        // is waited out to its last reply first).
+        request = loop {
+            let now = d.poll_timeout().expect("a frame is running");
+            match d.handle_timeout(now) {
+                Some(r) => break r,
+                None if d.is_done() => return (d.found().len(), d.frames(), now as f64 / 1e6),
+                None => {}
+            }
+        };
     }
 }
 

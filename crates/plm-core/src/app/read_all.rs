@@ -13,7 +13,7 @@ use super::frame::Address;
 use super::hid::{self, Hid};
 use super::message::Message;
 use super::requester::Request;
-use super::service::{Service, SlotRead};
+use super::service::{names, Service, SlotRead};
 use crate::time::{Instant, MS};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
@@ -60,10 +60,20 @@ impl ReadConfig {
         self.timing.slot_ms_for(2 + value) + HAND_OVER_MS
     }
 
-    /// How long one request naming `boards` lasts, from handing it over
-    /// to the last slot's reply arriving.
+    /// How long one request naming `boards` boards lasts at most (their
+    /// addresses in full), from handing it over to the last slot's reply
+    /// arriving.
     pub fn window(&self, boards: usize) -> crate::time::Duration {
-        let request = 1 + SlotRead::FIXED + 6 * boards;
+        self.window_of(boards, 1 + 6 * boards)
+    }
+
+    /// [`ReadConfig::window`] of a request naming `boards`.
+    pub fn window_naming(&self, boards: &[Address]) -> crate::time::Duration {
+        self.window_of(boards.len(), names::len(boards))
+    }
+
+    fn window_of(&self, boards: usize, names: usize) -> crate::time::Duration {
+        let request = 1 + SlotRead::FIXED + names;
         let slots = (self.first_ms as u64 + boards as u64 * self.slot_ms() as u64) * MS;
         self.timing.slotted(request, slots)
     }
@@ -108,14 +118,14 @@ impl ReadAll {
     }
 
     fn next(&mut self, now: Instant) -> Option<Request> {
-        let n = self.queue.len().min(SlotRead::MAX);
+        let n = SlotRead::fitting(self.queue.make_contiguous());
         if n == 0 {
             self.named.clear();
             self.window_ends = None;
             return None;
         }
         self.named = self.queue.drain(..n).collect();
-        self.window_ends = Some(now + self.config.window(n));
+        self.window_ends = Some(now + self.config.window_naming(&self.named));
         self.requests += 1;
         let read = SlotRead {
             slot_ms: self.config.slot_ms(),
@@ -214,8 +224,8 @@ mod tests {
     }
 
     #[test]
-    fn forty_boards_take_three_requests_and_the_silent_are_stragglers() {
-        let boards: Vec<Address> = (0..40).map(board).collect();
+    fn a_hundred_and_twenty_boards_take_three_requests_and_the_silent_are_stragglers() {
+        let boards: Vec<Address> = (0..120).map(board).collect();
         let (mut r, first) = ReadAll::start(0, &boards, ReadConfig::ALL);
         let mut now;
         let mut requests = alloc::vec![first.expect("a request")];
@@ -223,12 +233,12 @@ mod tests {
             let last = requests.last().expect("one");
             assert!(last.broadcast);
             for a in named(last) {
-                // Board 7 and board 33 stay silent; board 99 was not asked.
-                if a != board(7) && a != board(33) {
+                // Board 7 and board 83 stay silent; board 199 was not asked.
+                if a != board(7) && a != board(83) {
                     assert!(r.on_message(a, &reply(a.0[5])));
                 }
             }
-            assert!(!r.on_message(board(99), &reply(1)));
+            assert!(!r.on_message(board(199), &reply(1)));
             now = r.poll_timeout().expect("a window");
             match r.handle_timeout(now) {
                 Some(q) => requests.push(q),
@@ -237,14 +247,18 @@ mod tests {
         }
         assert!(r.is_done());
         let sizes: Vec<usize> = requests.iter().map(|q| named(q).len()).collect();
-        assert_eq!(sizes, [15, 15, 10]);
-        assert_eq!(r.stragglers(), [board(7), board(33)]);
-        assert_eq!(r.heard().len(), 38);
+        assert_eq!(sizes, [SlotRead::MOST, SlotRead::MOST, 20]);
+        assert_eq!(r.stragglers(), [board(7), board(83)]);
+        assert_eq!(r.heard().len(), 118);
         assert_eq!(r.heard()[0], (board(0), alloc::vec![0; 24]));
         let c = ReadConfig::ALL;
-        assert_eq!(now, 2 * c.window(15) + c.window(10));
-        // 40 boards in about 3 s (stop-and-wait: about 4.4 s).
-        assert!((2_900 * MS..3_100 * MS).contains(&now), "{now}");
+        let windows: crate::time::Duration = boards
+            .chunks(SlotRead::MOST)
+            .map(|b| c.window_naming(b))
+            .sum();
+        assert_eq!(now, windows);
+        // 120 boards in about 7.8 s (stop-and-wait: about 13 s).
+        assert!((7_700 * MS..7_900 * MS).contains(&now), "{now}");
     }
 
     #[test]
@@ -274,20 +288,30 @@ mod tests {
             panic!("a service request")
         };
         let p = s.payload();
-        assert_eq!(p.len(), 1 + 3 + 90);
-        assert_eq!(&p[..4], [0x13, 62, hid::ALL, FIRST_MS]);
+        // The five bytes every board shares once, then one byte each.
+        assert_eq!(p.len(), 1 + 3 + 1 + 5 + 15);
+        assert_eq!(
+            &p[..10],
+            [0x13, 62, hid::ALL, FIRST_MS, 5, 0, 0x80, 0xE1, 0, 1]
+        );
         assert_eq!(Service::parse(&p), Ok(s.clone()));
         assert_eq!(s.validate(), Ok(()));
-        assert!(Service::parse(&p[..p.len() - 1]).is_err());
-        let mut over = match s {
-            Service::ReadInSlots(r) => r,
-            _ => unreachable!(),
+        assert!(Service::parse(&p[..9]).is_err());
+        let Service::ReadInSlots(mut over) = s else {
+            unreachable!()
         };
-        over.addresses.push(board(15));
+        over.addresses = (0..=SlotRead::MOST as u8).map(board).collect();
+        let e = Service::ReadInSlots(over.clone()).validate().unwrap_err();
+        assert_eq!(
+            alloc::string::ToString::to_string(&e),
+            "addresses: a request names at most 50 of these boards, not 51"
+        );
+        // Addresses that share nothing take six bytes each: 15 fit.
+        over.addresses = (0..16u8).map(|i| Address([i, 1, 2, 3, 4, 5])).collect();
         let e = Service::ReadInSlots(over).validate().unwrap_err();
         assert_eq!(
             alloc::string::ToString::to_string(&e),
-            "addresses: a request names at most 15 boards, not 16"
+            "addresses: a request names at most 15 of these boards, not 16"
         );
     }
 }

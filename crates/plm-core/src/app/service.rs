@@ -123,9 +123,13 @@ pub mod fields {
     /// Slotted frame: a board answers when its draw (0-255) is at most
     /// this (255: every board).
     pub const SHARE: Field = Field::uint("share", "Share that answers", 5, 1);
-    /// Slotted frame: the addresses heard in the previous frame, 6 bytes
-    /// each, which stay quiet for the rest of the session.
-    pub const HEARD: Field = Field::bytes("heard", "Addresses heard", 6, 0);
+    /// Slotted frame: the bytes every address heard starts with
+    /// (`service::names`).
+    pub const HEARD_SHARED: Field = Field::uint("shared", "Bytes shared", 6, 1).range(0, 5);
+    /// Slotted frame: the addresses heard in the previous frame (the
+    /// shared bytes once, then the rest of each), which stay quiet for
+    /// the rest of the session.
+    pub const HEARD: Field = Field::bytes("heard", "Addresses heard", 7, 0);
     /// Discovery reply: SNR at which the board heard the request.
     pub const DISCOVERY_SNR: Field = Field::uint("snr", "SNR of the request", 4, 1)
         .range(0, SNR_MAX as i64)
@@ -138,9 +142,12 @@ pub mod fields {
     pub const READ_PARAM: Field = Field::uint("param", "HID parameter", 1, 1);
     /// Reads in slots: from the request heard to the first slot.
     pub const READ_FIRST_MS: Field = Field::uint("first_ms", "First slot after", 2, 1).unit("ms");
-    /// Reads in slots: the boards named, 6 bytes each; the board at
-    /// index i answers in slot i.
-    pub const READ_ADDRESSES: Field = Field::bytes("addresses", "Boards, in slot order", 3, 0);
+    /// Reads in slots: the bytes every address named starts with
+    /// (`service::names`).
+    pub const READ_SHARED: Field = Field::uint("shared", "Bytes shared", 3, 1).range(0, 5);
+    /// Reads in slots: the boards named (the shared bytes once, then the
+    /// rest of each); the board at index i answers in slot i.
+    pub const READ_ADDRESSES: Field = Field::bytes("addresses", "Boards, in slot order", 4, 0);
     /// Bytes not yet described (RFU, user commands).
     pub const DATA: Field = Field::bytes("data", "Data", 0, 0);
 
@@ -155,10 +162,24 @@ pub mod fields {
     /// NET_DISCOVER_REQ request, rule 1 (rounds).
     pub const DISCOVER: &[Field] = &[SESSION, WINDOW];
     /// NET_DISCOVER_REQ request, rule 2 (slotted frames).
-    pub const DISCOVER_FRAME: &[Field] =
-        &[RULE, FRAME_SESSION, FRAME, SLOTS, SLOT_MS, SHARE, HEARD];
+    pub const DISCOVER_FRAME: &[Field] = &[
+        RULE,
+        FRAME_SESSION,
+        FRAME,
+        SLOTS,
+        SLOT_MS,
+        SHARE,
+        HEARD_SHARED,
+        HEARD,
+    ];
     /// READ_IN_SLOTS request.
-    pub const READ_IN_SLOTS: &[Field] = &[READ_SLOT_MS, READ_PARAM, READ_FIRST_MS, READ_ADDRESSES];
+    pub const READ_IN_SLOTS: &[Field] = &[
+        READ_SLOT_MS,
+        READ_PARAM,
+        READ_FIRST_MS,
+        READ_SHARED,
+        READ_ADDRESSES,
+    ];
     /// NET_DISCOVER_REQ reply.
     pub const DISCOVERED: &[Field] = &[
         FIRMWARE_MAJOR,
@@ -333,8 +354,8 @@ pub const COMMANDS: &[ServiceDesc] = &[
         name: "SERVICE_READ_IN_SLOTS",
         what: "Boards named read a HID parameter and answer it each in its slot",
         request: f::READ_IN_SLOTS,
-        // 3 + 6 × 0..=15: any length is a request (the answers are HID
-        // replies, data frames).
+        // 3 + the names (`names`): any length is a request (the answers
+        // are HID replies, data frames).
         request_len: None,
         answer: Answer::None,
     },
@@ -437,8 +458,8 @@ pub struct SlotFrame {
     pub slot_ms: u8,
     /// A board answers when its draw is at most this (255: all).
     pub share: u8,
-    /// Addresses heard in the previous frame (at most
-    /// [`SlotFrame::MAX_HEARD`]).
+    /// Addresses heard in the previous frame (as many as fit:
+    /// [`SlotFrame::fitting`]).
     pub heard: Vec<Address>,
 }
 
@@ -447,8 +468,10 @@ impl SlotFrame {
     pub const RULE: u8 = 2;
     /// Data bytes before the heard addresses.
     pub const FIXED: usize = 6;
-    /// Addresses one request carries (the frame's 100-byte payload).
-    pub const MAX_HEARD: usize = 15;
+    /// How many of `heard`, from its start, one request can name.
+    pub fn fitting(heard: &[Address]) -> usize {
+        names::fitting(heard, Self::FIXED, usize::MAX)
+    }
     /// What a bare 0Bh (no data, as seed 004 lists it) stands for.
     pub const BARE: SlotFrame = SlotFrame {
         session: 0,
@@ -460,7 +483,7 @@ impl SlotFrame {
     };
 
     fn parse(d: &[u8]) -> Option<SlotFrame> {
-        let (fixed, heard) = fixed_then_addresses(d, Self::FIXED, Self::MAX_HEARD)?;
+        let (fixed, heard) = fixed_then_addresses(d, Self::FIXED)?;
         (fixed[0] == Self::RULE).then(|| SlotFrame {
             session: fixed[1],
             frame: fixed[2],
@@ -472,18 +495,92 @@ impl SlotFrame {
     }
 }
 
-/// `fixed` bytes, then at most `most` six-byte addresses: the layout of
+/// `fixed` bytes, then a list of addresses ([`names`]): the layout of
 /// the slotted requests (0Bh rule 2, 13h).
-fn fixed_then_addresses(d: &[u8], fixed: usize, most: usize) -> Option<(&[u8], Vec<Address>)> {
+fn fixed_then_addresses(d: &[u8], fixed: usize) -> Option<(&[u8], Vec<Address>)> {
     let (head, rest) = d.split_at_checked(fixed)?;
-    let fits = rest.len() % 6 == 0 && rest.len() / 6 <= most;
-    fits.then(|| {
-        let addresses = rest
-            .chunks_exact(6)
-            .map(|c| Address(c.try_into().expect("6 bytes")))
-            .collect();
-        (head, addresses)
-    })
+    Some((head, names::parse(rest)?))
+}
+
+/// The addresses a slotted request names (0Bh rule 2, 13h), in few
+/// bytes: `[p, prefix, suffixes...]`, where the `p` bytes (0-5) every
+/// address starts with are sent once, then each address's other `6 - p`
+/// bytes (docs/protocol-notes.md, "Discovery"). Boards of one street
+/// share their maker's first bytes at least, so a request names about
+/// twice as many boards as in full.
+pub mod names {
+    use super::super::frame::{Address, MAX_PAYLOAD};
+    use alloc::vec::Vec;
+
+    /// Bytes shared by every address in `list` at its start (at most 5).
+    pub fn shared(list: &[Address]) -> usize {
+        let Some(first) = list.first() else {
+            return 0;
+        };
+        list.iter().fold(5, |p, a| {
+            p.min(
+                first
+                    .0
+                    .iter()
+                    .zip(a.0)
+                    .take_while(|(x, y)| **x == *y)
+                    .count(),
+            )
+        })
+    }
+
+    /// The bytes `list` takes.
+    pub fn len(list: &[Address]) -> usize {
+        let p = shared(list);
+        1 + p + list.len() * (6 - p)
+    }
+
+    /// How many of `list`, from its start, fit in a request whose other
+    /// data takes `fixed` bytes (the frame's 100-byte payload, its
+    /// command byte included), and no more than `most`.
+    pub fn fitting(list: &[Address], fixed: usize, most: usize) -> usize {
+        let room = MAX_PAYLOAD - 1 - fixed;
+        (0..=list.len().min(most))
+            .take_while(|k| len(&list[..*k]) <= room)
+            .last()
+            .unwrap_or(0)
+    }
+
+    /// Appends `list` to `out`.
+    pub fn emit(list: &[Address], out: &mut Vec<u8>) {
+        let p = shared(list);
+        out.push(p as u8);
+        if let Some(first) = list.first() {
+            out.extend_from_slice(&first.0[..p]);
+        }
+        for a in list {
+            out.extend_from_slice(&a.0[p..]);
+        }
+    }
+
+    /// The addresses of `d`, or `None` when it is not such a list.
+    pub fn parse(d: &[u8]) -> Option<Vec<Address>> {
+        let (&p, rest) = d.split_first()?;
+        let p = p as usize;
+        if p > 5 {
+            return None;
+        }
+        let (prefix, tails) = rest.split_at_checked(p)?;
+        if !tails.len().is_multiple_of(6 - p) {
+            return None;
+        }
+        Some(
+            tails
+                .chunks_exact(6 - p)
+                .map(|tail| {
+                    let mut a = [0; 6];
+                    a[..p].copy_from_slice(prefix);
+                    a[p..].copy_from_slice(tail);
+                    Address(a)
+                })
+                .collect(),
+        )
+    }
 }
 
 /// A SERVICE_READ_IN_SLOTS request (docs/protocol-notes.md, "Reads in
@@ -498,19 +595,24 @@ pub struct SlotRead {
     pub param: u8,
     /// From the request heard to slot 0, ms.
     pub first_ms: u8,
-    /// The boards named, in slot order (at most [`SlotRead::MAX`]).
+    /// The boards named, in slot order (at most [`SlotRead::MOST`]).
     pub addresses: Vec<Address>,
 }
 
 impl SlotRead {
     /// Data bytes before the addresses.
     pub const FIXED: usize = 3;
-    /// Boards one request names (3 + 6 × 15 = 93 data bytes in the
-    /// 100-byte payload).
-    pub const MAX: usize = 15;
+    /// Boards one request names at most: 50 slots of GET ALL are 3.1 s
+    /// at B-PSK, as long as a view's own request waits behind them.
+    pub const MOST: usize = 50;
+
+    /// How many of `boards`, from its start, one request can name.
+    pub fn fitting(boards: &[Address]) -> usize {
+        names::fitting(boards, Self::FIXED, Self::MOST)
+    }
 
     fn parse(d: &[u8]) -> Option<SlotRead> {
-        let (fixed, addresses) = fixed_then_addresses(d, Self::FIXED, Self::MAX)?;
+        let (fixed, addresses) = fixed_then_addresses(d, Self::FIXED)?;
         Some(SlotRead {
             slot_ms: fixed[0],
             param: fixed[1],
@@ -926,9 +1028,7 @@ impl Service {
                     fr.slot_ms,
                     fr.share,
                 ]);
-                for a in &fr.heard {
-                    out.extend_from_slice(&a.0);
-                }
+                names::emit(&fr.heard, &mut out);
             }
             DiscoverReply(r) => out.extend_from_slice(&[
                 r.firmware.major,
@@ -960,9 +1060,7 @@ impl Service {
             RfuStatusGet { campaign } | RfuAbort { campaign } => out.push(*campaign),
             ReadInSlots(r) => {
                 out.extend_from_slice(&[r.slot_ms, r.param, r.first_ms]);
-                for a in &r.addresses {
-                    out.extend_from_slice(&a.0);
-                }
+                names::emit(&r.addresses, &mut out);
             }
             RfuStatus(s) => {
                 out.extend_from_slice(&[s.campaign, s.state, s.reason]);
@@ -1002,7 +1100,7 @@ impl Service {
         let data = &payload[1..];
         if let Some(desc) = self.desc() {
             let want = if let Service::DiscoverFrame(fr) = self {
-                Some(SlotFrame::FIXED + 6 * fr.heard.len().min(SlotFrame::MAX_HEARD))
+                Some(SlotFrame::FIXED + names::len(&fr.heard))
             } else if matches!(self, Service::DiscoverAny) {
                 Some(0)
             } else if self.is_request() {
@@ -1021,17 +1119,19 @@ impl Service {
                 });
             }
         }
-        if let Service::ReadInSlots(r) = self {
-            if r.addresses.len() > SlotRead::MAX {
-                return Err(ServiceError::Field(FieldError {
-                    field: "addresses",
-                    reason: alloc::format!(
-                        "a request names at most {} boards, not {}",
-                        SlotRead::MAX,
-                        r.addresses.len()
-                    ),
-                }));
-            }
+        let named = match self {
+            Service::ReadInSlots(r) => Some((&r.addresses, SlotRead::fitting(&r.addresses))),
+            Service::DiscoverFrame(fr) => Some((&fr.heard, SlotFrame::fitting(&fr.heard))),
+            _ => None,
+        };
+        if let Some((list, fit)) = named.filter(|(list, fit)| *fit < list.len()) {
+            return Err(ServiceError::Field(FieldError {
+                field: "addresses",
+                reason: alloc::format!(
+                    "a request names at most {fit} of these boards, not {}",
+                    list.len()
+                ),
+            }));
         }
         if let Service::RfuData { data: segment, .. } = self {
             if !(1..=rfu::SEGMENT).contains(&segment.len()) {
@@ -1126,7 +1226,8 @@ mod tests {
     #[test]
     fn every_described_command_round_trips() {
         for d in COMMANDS {
-            let data = alloc::vec![0; d.request_len.unwrap_or(3)];
+            // Of a variable length: three bytes and an empty list of names.
+            let data = alloc::vec![0; d.request_len.unwrap_or(4)];
             let mut p = alloc::vec![d.code];
             p.extend_from_slice(&data);
             let s = Service::parse(&p).unwrap();

@@ -3,17 +3,19 @@
 //! All it can observe is how many boards a frame heard for the first
 //! time: an empty slot and a collision sound alike, on a real line as on
 //! the simulated one. So it keeps a belief over how many boards are left
-//! (0 to a bound well above its guess), updated after every frame by
-//! Bayes' rule with the chance of hearing that many new boards, then
-//! shifted down by them (docs/protocol-notes.md, "Discovery").
+//! (0 to a bound well above its guess) and how readily the line captures
+//! one reply out of several, updated after every frame by Bayes' rule
+//! with the chance of hearing that many new boards, then shifted down by
+//! them (docs/protocol-notes.md, "Discovery").
 //!
 //! The chance counts the boards that answer (those whose draw is within
-//! the share, less the ones that missed the request), the ones alone in
-//! their slot, and those whose reply was not lost. For up to
-//! [`EXACT_UP_TO`] boards it is exact (inclusion and exclusion over the
-//! boards heard alone), which is what the stop rule leans on; for more,
-//! a binomial with the exact mean.
-
+//! the share, less the ones that missed the request), the ones heard in
+//! their slot (alone, or captured out of a collision), and those whose
+//! reply was not lost. Without capture and for up to [`EXACT_UP_TO`]
+//! boards it is exact (inclusion and exclusion over the boards heard
+//! alone), which is what the stop rule leans on; otherwise a binomial
+//! over the slots with the exact mean.
+use super::super::frame::Address;
 use super::{Timing, MAX_SLOTS};
 use alloc::vec::Vec;
 
@@ -26,12 +28,19 @@ pub const LOSS_ALLOWED: f64 = 0.05;
 /// this.
 pub const STOP_RISK: f64 = 1e-5;
 
-/// The most the belief allows for the chance that a slot several boards
-/// answer in is heard all the same, the strongest reply captured. How
-/// often a line captures depends on how far apart the levels are, so
-/// any chance up to this one is allowed: a frame that hears a few boards
-/// amid a crowd must not be read as "few are left".
-pub const CAPTURE_ALLOWED: f64 = 0.75;
+/// How readily the line captures, the values the belief weighs: a slot
+/// that k ≥ 2 boards answer is heard with chance `p^k` (the strongest
+/// reply clears the receiver's margin over each of the others, as when
+/// levels are spread evenly and the margin is `1 - p` of the spread).
+/// The values give a two-reply slot a chance of 0, 0.15, 0.3, 0.45, 0.6
+/// and 0.75. One value holds for the whole street: a line that captured
+/// in one frame captures in the next, so a crowd cannot hide behind a
+/// capture in one frame and behind silence in the next.
+pub const CAPTURES: [f64; 6] = [0.0, 0.387_298, 0.547_723, 0.670_820, 0.774_597, 0.866_025];
+
+/// The share of the belief in each capture value that moves to the next
+/// lower one after each frame ([`Estimate::observe`]).
+pub const CAPTURE_FADES: f64 = 0.1;
 
 /// Boards up to which the chance of a frame's count is exact.
 pub const EXACT_UP_TO: usize = 24;
@@ -48,10 +57,14 @@ pub struct Plan {
     pub others: usize,
 }
 
-/// The belief: `belief[n]` is the chance that `n` boards are left.
+/// `belief[n][k]`: the chance that `n` boards are left and the line
+/// captures as `CAPTURES[k]` says.
+type Row = [f64; CAPTURES.len()];
+
+/// The belief over the boards left and the line's capture.
 #[derive(Debug, Clone)]
 pub struct Estimate {
-    belief: Vec<f64>,
+    belief: Vec<Row>,
 }
 
 impl Estimate {
@@ -60,7 +73,7 @@ impl Estimate {
     /// guess (at least 256, at most [`MOST`]; the rest, spread evenly
     /// over the orders of magnitude): a street far larger than guessed
     /// (the console's first guess is 12) is still looked for, by frames
-    /// that only a few boards answer.
+    /// that only a few boards answer. Every capture value alike.
     pub fn new(guess: usize) -> Estimate {
         let g = guess.max(1) as f64;
         let top = (64 * guess).clamp(256, MOST);
@@ -77,7 +90,10 @@ impl Estimate {
         let belief = bell
             .iter()
             .enumerate()
-            .map(|(n, b)| BELL * b / bell_total + (1.0 - BELL) / (n as f64 + 1.0) / wide_total)
+            .map(|(n, b)| {
+                let p = BELL * b / bell_total + (1.0 - BELL) / (n as f64 + 1.0) / wide_total;
+                [p; CAPTURES.len()]
+            })
             .collect();
         let mut e = Estimate { belief };
         e.normalise();
@@ -87,11 +103,11 @@ impl Estimate {
     /// Scales the belief to a total of 1 and drops what is negligible
     /// (the arithmetic then skips it); false when nothing is left.
     fn normalise(&mut self) -> bool {
-        let total: f64 = self.belief.iter().sum();
+        let total: f64 = self.belief.iter().flatten().sum();
         if !(total > 0.0 && total.is_finite()) {
             return false;
         }
-        for p in self.belief.iter_mut() {
+        for p in self.belief.iter_mut().flatten() {
             *p /= total;
             if *p < NEGLIGIBLE {
                 *p = 0.0;
@@ -100,7 +116,7 @@ impl Estimate {
         let end = self
             .belief
             .iter()
-            .rposition(|p| *p > 0.0)
+            .rposition(|row| row.iter().any(|p| *p > 0.0))
             .map_or(1, |i| i + 1);
         self.belief.truncate(end);
         true
@@ -111,28 +127,57 @@ impl Estimate {
         self.belief
             .iter()
             .enumerate()
-            .map(|(n, p)| n as f64 * p)
+            .map(|(n, row)| n as f64 * row.iter().sum::<f64>())
             .sum()
     }
 
     /// The chance that any board is left.
     pub fn anybody(&self) -> f64 {
-        1.0 - self.belief[0]
+        1.0 - self.belief[0].iter().sum::<f64>()
     }
 
     /// A frame of `plan` heard `new` boards for the first time.
     pub fn observe(&mut self, plan: &Plan, new: usize) {
         let before = core::mem::take(&mut self.belief);
+        // A silent frame on a line that captures: the exact chance for
+        // the few boards the stop rule weighs (with others answering,
+        // none: [`chance`]'s safe side). A line that lags or loses
+        // requests wholesale silences a crowd too: silence is never taken
+        // as proof against many boards.
+        let silence = CAPTURES.map(|capture| {
+            (new == 0 && plan.others == 0 && capture > 0.0)
+                .then(|| silent_when_answering(plan, capture))
+        });
         self.belief = (0..before.len().max(1))
-            .map(|m| match before.get(m + new) {
-                Some(p) if *p > 0.0 => p * chance(m + new, new, plan),
-                _ => 0.0,
+            .map(|m| {
+                let mut row = [0.0; CAPTURES.len()];
+                if let Some(was) = before.get(m + new) {
+                    for (k, p) in was.iter().enumerate().filter(|(_, p)| **p > 0.0) {
+                        row[k] = p * match &silence[k] {
+                            Some(by_answering) if m <= EXACT_UP_TO => silent(m, plan, by_answering),
+                            _ => chance(m + new, new, plan, CAPTURES[k]),
+                        };
+                    }
+                }
+                row
             })
             .collect();
         if !self.normalise() {
             // The belief said this could not happen: start again from
             // what was heard.
             self.belief = Estimate::new(new.max(1)).belief;
+        }
+        // The strongest boards win the captures, so they are found
+        // first: the boards left capture less and less. Each frame, a
+        // share of the belief in each capture value moves to the next
+        // lower one, so that a line that captured early cannot make a
+        // crowd of weaker boards look like a few.
+        for row in self.belief.iter_mut() {
+            for k in 1..CAPTURES.len() {
+                let down = row[k] * CAPTURE_FADES;
+                row[k] -= down;
+                row[k - 1] += down;
+            }
         }
     }
 
@@ -141,7 +186,7 @@ impl Estimate {
     /// names and `others` the boards found that will answer again. Over
     /// the whole belief: a small chance of many boards left makes a frame
     /// that few answer worth its time.
-    pub fn plan(&self, timing: &Timing, heard: usize, others: usize) -> Plan {
+    pub fn plan(&self, timing: &Timing, heard: &[Address], others: usize) -> Plan {
         let mut best = (Plan::default(), -1.0);
         for slots in SLOT_CHOICES.iter().copied().filter(|s| *s <= MAX_SLOTS) {
             for share in SHARE_CHOICES {
@@ -161,17 +206,81 @@ impl Estimate {
 
     /// The mean number of new boards a frame of `plan` hears.
     fn expected_finds(&self, plan: &Plan) -> f64 {
-        let (q, l) = (answering(plan.share), plan.slots as f64);
-        let heard_alone = q * (1.0 - LOSS_ALLOWED);
-        // (1 - q/l)^(n - 1 + others), kept from one n to the next.
-        let mut apart = powi(1.0 - q / l, plan.others);
+        let slots = plan.slots as f64;
         let mut total = 0.0;
-        for (n, p) in self.belief.iter().enumerate().skip(1) {
-            total += p * n as f64 * heard_alone * apart;
-            apart *= 1.0 - q / l;
+        for (k, capture) in CAPTURES.iter().enumerate() {
+            let mut slot = Slot::new(plan, *capture);
+            let mut n = 1;
+            while n < self.belief.len() {
+                // Many boards are weighed in groups of a 64th of their
+                // number (the chance changes little within one): the plan
+                // costs a few hundred steps, not thousands; the belief
+                // itself stays exact.
+                let end = (n + (n / 64).max(1)).min(self.belief.len());
+                let mass: f64 = self.belief[n..end].iter().map(|row| row[k]).sum();
+                if mass > 0.0 {
+                    total += mass * slots * slot.at(n);
+                }
+                n = end;
+            }
         }
         total
     }
+}
+
+/// The chance that one slot of a frame hears a new board, for a growing
+/// number of new boards (the powers carried from one to the next).
+struct Slot {
+    /// The chance a board answers in this slot.
+    u: f64,
+    capture: f64,
+    others: usize,
+    /// New boards.
+    n: usize,
+    /// `(1 - u)^(m - 1)` and `(1 - u + u capture)^m`, `m` the boards
+    /// answering (new and others).
+    apart: f64,
+    captured: f64,
+}
+
+impl Slot {
+    /// One new board.
+    fn new(plan: &Plan, capture: f64) -> Slot {
+        let u = answering(plan.share) / plan.slots as f64;
+        Slot {
+            u,
+            capture,
+            others: plan.others,
+            n: 1,
+            apart: powi(1.0 - u, plan.others),
+            captured: powi(1.0 - u + u * capture, plan.others + 1),
+        }
+    }
+
+    /// With `n` new boards (no fewer than the last asked): the chance
+    /// the slot hears a new one.
+    fn at(&mut self, n: usize) -> f64 {
+        let (u, c) = (self.u, self.capture);
+        let more = n - self.n;
+        if more > 0 {
+            self.apart *= powi(1.0 - u, more);
+            self.captured *= powi(1.0 - u + u * c, more);
+            self.n = n;
+        }
+        hears_new(u, c, n, n + self.others, self.apart, self.captured)
+    }
+}
+
+/// The chance one slot hears a new board: `n` new boards, `m` answering
+/// in all (new and others), each in this slot with chance `u`; `apart`
+/// is `(1-u)^(m-1)` and `all` is `(1-u+uc)^m`. One board alone, or k ≥ 2
+/// heard with chance `c^k`:
+/// Σ C(m,k) u^k (1-u)^(m-k) c^k = (1-u+uc)^m - (1-u)^m - m u c (1-u)^(m-1).
+fn hears_new(u: f64, c: f64, n: usize, m: usize, apart: f64, all: f64) -> f64 {
+    let mf = m as f64;
+    let alone = mf * u * apart;
+    let crowd = (all - apart * (1.0 - u) - mf * u * c * apart).max(0.0);
+    (alone + crowd) * (1.0 - LOSS_ALLOWED) * n as f64 / mf
 }
 
 /// The largest street the belief holds.
@@ -196,31 +305,83 @@ fn answering(share: u8) -> f64 {
 }
 
 /// The chance that a frame of `plan` hears exactly `s` of `n` new
-/// boards: on a line without capture, or with the capture chance (up to
-/// [`CAPTURE_ALLOWED`]) that explains the count best, whichever is
-/// larger: a count is never taken as proof against a crowd that capture
-/// explains.
-pub fn chance(n: usize, s: usize, plan: &Plan) -> f64 {
+/// boards on a line that captures as `capture` says ([`CAPTURES`]): a
+/// binomial over the slots. A silent frame: the chance without capture,
+/// which capture could only lower, so that silence never rules out a
+/// crowd (a crowd is ruled out by a frame that few of it answer, where
+/// it would be heard); [`Estimate::observe`] is exact with capture for
+/// up to [`EXACT_UP_TO`] boards, which the stop rule leans on.
+pub fn chance(n: usize, s: usize, plan: &Plan, capture: f64) -> f64 {
     if s > n {
         return 0.0;
     }
-    let plain = without_capture(n, s, plan);
-    if s == 0 {
-        return plain;
+    if capture == 0.0 || s == 0 {
+        return without_capture(n, s, plan);
     }
-    // Slot by slot: one board alone is heard unless lost; a slot with
-    // more is heard with the capture allowance; the one heard is new in
-    // the share of new boards among those answering.
-    let (q, l) = (answering(plan.share), plan.slots as f64);
-    let crowd = n + plan.others;
-    let empty = powi(1.0 - q / l, crowd);
-    let alone = crowd as f64 * q / l * powi(1.0 - q / l, crowd - 1);
-    let heard = |capture: f64| {
-        (alone + capture * (1.0 - empty - alone)).max(0.0) * (1.0 - LOSS_ALLOWED) * n as f64
-            / crowd as f64
-    };
-    let best = (s as f64 / l).min(heard(CAPTURE_ALLOWED)).max(heard(0.0));
-    plain.max(binomial(plan.slots as usize, s, best))
+    let u = answering(plan.share) / plan.slots as f64;
+    let m = n + plan.others;
+    let h = hears_new(
+        u,
+        capture,
+        n,
+        m,
+        powi(1.0 - u, m - 1),
+        powi(1.0 - u + u * capture, m),
+    );
+    binomial(plan.slots as usize, s, h)
+}
+
+/// The chance that a frame of `plan` hears nobody when `a` of its boards
+/// answer, for `a` up to [`EXACT_UP_TO`], on a line that captures as
+/// `capture` says: the `a` replies spread evenly over the slots (the
+/// multinomial, through its exponential generating function), a slot of
+/// k ≥ 1 replies silent unless one is heard (alone: unless lost; more:
+/// with chance `capture^k`, unless lost).
+fn silent_when_answering(plan: &Plan, capture: f64) -> [f64; EXACT_UP_TO + 1] {
+    const N: usize = EXACT_UP_TO + 1;
+    let mut slot = [0.0; N]; // (1 - heard_k) / k!
+    let mut factorial = 1.0;
+    for (k, e) in slot.iter_mut().enumerate() {
+        if k > 0 {
+            factorial *= k as f64;
+        }
+        let heard = match k {
+            0 => 0.0,
+            1 => 1.0 - LOSS_ALLOWED,
+            _ => powi(capture, k) * (1.0 - LOSS_ALLOWED),
+        };
+        *e = (1.0 - heard) / factorial;
+    }
+    let mut frame = [0.0; N];
+    frame[0] = 1.0;
+    for _ in 0..plan.slots {
+        let mut next = [0.0; N];
+        for (i, f) in frame.iter().enumerate().filter(|(_, f)| **f != 0.0) {
+            for (j, e) in slot.iter().enumerate().take(N - i) {
+                next[i + j] += f * e;
+            }
+        }
+        frame = next;
+    }
+    // P(silent | a) = a! / L^a × [x^a] slot(x)^L.
+    let mut scale = 1.0;
+    let mut out = [0.0; N];
+    for (a, o) in out.iter_mut().enumerate() {
+        if a > 0 {
+            scale *= a as f64 / plan.slots as f64;
+        }
+        *o = (scale * frame[a]).clamp(0.0, 1.0);
+    }
+    out
+}
+
+/// The chance that a frame of `plan` hears nobody from `n` boards
+/// (`n` up to [`EXACT_UP_TO`]), from [`silent_when_answering`].
+fn silent(n: usize, plan: &Plan, by_answering: &[f64; EXACT_UP_TO + 1]) -> f64 {
+    let q = answering(plan.share);
+    (0..=n)
+        .map(|a| choose(n, a) * powi(q, a) * powi(1.0 - q, n - a) * by_answering[a])
+        .sum()
 }
 
 /// `P(X = s)` for `X` binomial over `n` trials of chance `h`.
@@ -308,15 +469,40 @@ mod tests {
         }
         // One board, every board answering: heard unless its request or
         // its reply was lost.
-        let one = chance(1, 0, &plan(4, 255));
+        let one = chance(1, 0, &plan(4, 255), CAPTURES[5]);
         assert!((one - (1.0 - 0.95 * 0.95)).abs() < 1e-12, "{one}");
         // Two boards, four slots: silent when both answer and collide
         // (0.95² × 1/4) or both replies are lost (0.95² × 3/4 × 0.05²),
         // when one answers and its reply is lost (2 × 0.95 × 0.05 × 0.05),
         // or when neither answers (0.05²).
-        let two = chance(2, 0, &plan(4, 255));
+        let two = chance(2, 0, &plan(4, 255), CAPTURES[5]);
         let want = 0.9025 * (0.25 + 0.75 * 0.0025) + 0.095 * 0.05 + 0.0025;
         assert!((two - want).abs() < 1e-12, "{two} {want}");
+    }
+
+    #[test]
+    fn the_exact_silence_with_capture_matches_the_chance_without_and_falls_with_capture() {
+        for p in [plan(2, 255), plan(8, 255), plan(32, 100)] {
+            let none = silent_when_answering(&p, 0.0);
+            let some = silent_when_answering(&p, CAPTURES[3]);
+            for n in 0..=EXACT_UP_TO {
+                let exact = without_capture(n, 0, &p);
+                let ours = silent(n, &p, &none);
+                assert!((exact - ours).abs() < 1e-9, "n {n} {p:?}: {exact} {ours}");
+                assert!(silent(n, &p, &some) <= ours + 1e-12);
+            }
+        }
+        // Two boards in two slots, every board answering, capture 1/2 for
+        // two replies: silent when both collide and the slot is not
+        // captured or lost, or what is heard is lost, or nobody answers.
+        let c = core::f64::consts::FRAC_1_SQRT_2;
+        let p = plan(2, 255);
+        let got = silent(2, &p, &silent_when_answering(&p, c));
+        let (q, h) = (0.95, 0.95);
+        let both = q * q * (0.5 * (1.0 - 0.5 * h) + 0.5 * (1.0 - h) * (1.0 - h));
+        let one = 2.0 * q * (1.0 - q) * (1.0 - h);
+        let want = both + one + (1.0 - q) * (1.0 - q);
+        assert!((got - want).abs() < 1e-12, "{got} {want}");
     }
 
     #[test]
@@ -324,10 +510,10 @@ mod tests {
         let mut e = Estimate::new(12);
         let (mut frames, mut line) = (0, 0);
         while e.anybody() >= STOP_RISK {
-            let p = e.plan(&Timing::BPSK, 0, 0);
+            let p = e.plan(&Timing::BPSK, &[], 0);
             e.observe(&p, 0);
             frames += 1;
-            line += Timing::BPSK.frame(p.slots, 0);
+            line += Timing::BPSK.frame(p.slots, &[]);
         }
         // Larger streets than guessed are ruled out too, by wide frames few
         // boards answer: about 6 s in all.
@@ -343,8 +529,33 @@ mod tests {
         // capture one may be, and the belief must allow it.
         let p = plan(4, 255);
         assert!(without_capture(60, 1, &p) < 1e-4);
-        assert!(chance(60, 1, &p) > 0.1, "{}", chance(60, 1, &p));
-        // A silent frame stays likely for a crowd (no capture happened).
-        assert!(chance(60, 0, &p) > 0.9);
+        let most = chance(60, 1, &p, CAPTURES[5]);
+        assert!(most > 0.1, "{most}");
+        // A silent frame stays likely for a crowd, whatever the line
+        // captures: silence never rules a crowd out.
+        assert!(chance(60, 0, &p, 0.0) > 0.9);
+        assert_eq!(chance(60, 0, &p, CAPTURES[5]), chance(60, 0, &p, 0.0));
+    }
+
+    #[test]
+    fn a_line_that_captures_is_believed_to_and_the_stop_follows_in_a_few_frames() {
+        // 40 boards, guessed 40, capture at 0.6 for two replies: a frame
+        // of 32 slots that every board answers hears about 20 (alone or
+        // captured); one that does not capture would hear about 9.
+        let mut e = Estimate::new(40);
+        e.observe(&plan(32, 255), 20);
+        let capture: f64 = e.belief.iter().map(|r| r[4] + r[5]).sum();
+        assert!(capture > 0.5, "{capture}");
+        // The 20 left, all heard in turn, then silence: a few short frames
+        // for the few that could be left, one a crowd would be heard in.
+        e.observe(&plan(32, 255), 16);
+        e.observe(&plan(8, 255), 4);
+        let mut plans = Vec::new();
+        while e.anybody() >= STOP_RISK {
+            let p = e.plan(&Timing::BPSK, &[], 0);
+            e.observe(&p, 0);
+            plans.push((p.slots, p.share));
+        }
+        assert!(plans.len() <= 8, "{plans:?}");
     }
 }
