@@ -13,8 +13,10 @@
 //! their slot (alone, or captured out of a collision), and those whose
 //! reply was not lost. Without capture and for up to [`EXACT_UP_TO`]
 //! boards it is exact (inclusion and exclusion over the boards heard
-//! alone), which is what the stop rule leans on; otherwise a binomial
-//! over the slots with the exact mean.
+//! alone); otherwise a binomial over the slots with the exact mean. A
+//! silent frame is weighed as on a line that does not capture, so that
+//! silence never rules out a crowd, except for up to [`EXACT_UP_TO`]
+//! boards, where it is exact with capture: the stop rule leans on it.
 use super::super::frame::Address;
 use super::{Timing, MAX_SLOTS};
 use alloc::vec::Vec;
@@ -33,9 +35,10 @@ pub const STOP_RISK: f64 = 1e-5;
 /// reply clears the receiver's margin over each of the others, as when
 /// levels are spread evenly and the margin is `1 - p` of the spread).
 /// The values give a two-reply slot a chance of 0, 0.15, 0.3, 0.45, 0.6
-/// and 0.75. One value holds for the whole street: a line that captured
-/// in one frame captures in the next, so a crowd cannot hide behind a
-/// capture in one frame and behind silence in the next.
+/// and 0.75. One value holds for the whole street (less and less of it,
+/// [`CAPTURE_FADES`]): a line that captured in one frame captures in the
+/// next, so that a few boards heard in a frame are read against what the
+/// line showed before, not against the capture that best excuses a crowd.
 pub const CAPTURES: [f64; 6] = [0.0, 0.387_298, 0.547_723, 0.670_820, 0.774_597, 0.866_025];
 
 /// The share of the belief in each capture value that moves to the next
