@@ -1,6 +1,7 @@
 // Minifies the JavaScript of a release build in dist/ (the wasm-bindgen
 // glue, without the stream classes the wasm no longer exports, and the
-// service worker) with terser, gives the wasm's imports and
+// service worker) with terser, puts the wasm's functions in an order gzip
+// does well with (order-functions.mjs), gives the wasm's imports and
 // exports between it and the glue short names (short-names.mjs), and
 // rewrites the Subresource Integrity hashes index.html gives for them. `cargo xtask dist` runs it
 // after Trunk: the console's 350 KiB budget counts every JS file, and
@@ -15,6 +16,7 @@ import fs from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { minify } from 'terser';
+import { orderFunctions } from './order-functions.mjs';
 import { shortenNames } from './short-names.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -50,7 +52,7 @@ for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sor
   const module = wasm !== null;
   if (module) before = dropStreamClasses(before);
   if (wasm) {
-    const short = shortenNames(wasm, before);
+    const short = shortenNames(orderFunctions(wasm), before);
     before = short.js;
     await fs.writeFile(wasmFile, short.wasm);
     const oldWasm = sri(wasm);
