@@ -21,7 +21,7 @@
 
 pub mod image;
 
-use super::service::Release;
+use super::release::Release;
 use crate::CrcImpl;
 use alloc::format;
 use alloc::string::String;

@@ -9,6 +9,7 @@
 
 use super::error::ErrorCode;
 use super::frame::Address;
+pub use super::release::Release;
 use super::rfu::{self, fields as rf};
 use crate::field::{self, Field, FieldError};
 use alloc::vec::Vec;
@@ -364,35 +365,6 @@ pub const COMMANDS: &[ServiceDesc] = &[
 /// The description of a command code.
 pub fn describe(code: u8) -> Option<&'static ServiceDesc> {
     COMMANDS.iter().find(|d| d.code == code)
-}
-
-/// A release `x.y`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
-pub struct Release {
-    /// x.
-    pub major: u8,
-    /// y.
-    pub minor: u8,
-}
-
-impl Release {
-    /// `x.y` as people write a release (spaces around it allowed); the
-    /// reason in words if it is not one.
-    pub fn parse(text: &str) -> Result<Release, alloc::string::String> {
-        let t = text.trim();
-        let bad = || alloc::format!("'{t}' is not a release: two numbers 0-255 as x.y, e.g. 1.5");
-        let (x, y) = t.split_once('.').ok_or_else(bad)?;
-        Ok(Release {
-            major: x.parse().map_err(|_| bad())?,
-            minor: y.parse().map_err(|_| bad())?,
-        })
-    }
-}
-
-impl fmt::Display for Release {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}.{}", self.major, self.minor)
-    }
 }
 
 /// A time of day as the board's RTC keeps it.
@@ -1158,21 +1130,6 @@ impl Service {
 mod tests {
     use super::*;
 
-    #[test]
-    fn releases_are_read_as_people_write_them() {
-        assert_eq!(Release::parse(" 1.5 "), Ok(Release { major: 1, minor: 5 }));
-        assert_eq!(
-            Release::parse("255.0"),
-            Ok(Release {
-                major: 255,
-                minor: 0
-            })
-        );
-        for bad in ["2", "1.", ".5", "1.256", "a.b", "1.5.1"] {
-            let why = Release::parse(bad).unwrap_err();
-            assert!(why.contains("is not a release"), "{bad}: {why}");
-        }
-    }
     use alloc::string::ToString;
 
     #[test]

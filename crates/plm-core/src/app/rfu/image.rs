@@ -22,7 +22,7 @@
 //! | 12 | 4 | CRC-32 of the image with these 4 bytes left out, little-endian |
 
 use super::{image_crc, IMAGE_MAX};
-use crate::app::service::Release;
+use crate::app::release::Release;
 use crate::CrcImpl;
 use alloc::format;
 use alloc::string::String;
