@@ -232,11 +232,15 @@ impl fmt::Display for ParseError {
             ),
             [n] => write!(f, "{name} carries {n} data bytes, not {}", self.got),
             [a, b] => write!(f, "{name} carries {a} or {b} data bytes, not {}", self.got),
-            more => write!(
-                f,
-                "{name} carries one of {more:?} data bytes, not {}",
-                self.got
-            ),
+            // `[a, b, c]` written out: a slice's Debug is the console's
+            // only use of core's list formatting.
+            more => {
+                write!(f, "{name} carries one of [")?;
+                for (i, n) in more.iter().enumerate() {
+                    write!(f, "{}{n}", if i == 0 { "" } else { ", " })?;
+                }
+                write!(f, "] data bytes, not {}", self.got)
+            }
         }
     }
 }
@@ -563,4 +567,38 @@ impl Command {
 
 fn signal_noise_len() -> usize {
     f::signal_noise::LEN
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::format;
+    use alloc::string::ToString;
+
+    #[test]
+    fn a_length_refused_names_the_lengths_the_command_takes() {
+        let e = |expected: &'static [usize], min| ParseError {
+            code: c::CMD_ALARM_INDICATION,
+            expected,
+            min,
+            got: 3,
+        };
+        let name = c::name(c::CMD_ALARM_INDICATION).unwrap();
+        assert_eq!(
+            e(&[], 5).to_string(),
+            format!("{name} carries at least 5 data bytes, not 3")
+        );
+        assert_eq!(
+            e(&[4], 0).to_string(),
+            format!("{name} carries 4 data bytes, not 3")
+        );
+        assert_eq!(
+            e(&[4, 17], 0).to_string(),
+            format!("{name} carries 4 or 17 data bytes, not 3")
+        );
+        assert_eq!(
+            e(&[1, 4, 17], 0).to_string(),
+            format!("{name} carries one of [1, 4, 17] data bytes, not 3")
+        );
+    }
 }
