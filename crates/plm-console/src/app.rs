@@ -123,9 +123,11 @@ pub fn App() -> impl IntoView {
     crate::bench_hook::install(console);
     crate::wake::install(move || console.tick());
     crate::wake::soon();
-    let tab = signal(Tab::from_hash(&current_hash()));
+    // The tab shown, by its slug: a String signal, a type the page has
+    // (a signal type of its own brings its own code, docs/console.md "Size").
+    let tab = signal(Tab::from_hash(&current_hash()).slug().to_string());
     let on_hash = window_event_listener(leptos::ev::hashchange, move |_| {
-        tab.set(Tab::from_hash(&current_hash()));
+        tab.set(Tab::from_hash(&current_hash()).slug().to_string());
     });
     on_cleanup(move || on_hash.remove());
     // Leaving the page mid-update asks first (the campaign is kept and
@@ -156,8 +158,8 @@ pub fn App() -> impl IntoView {
                                 class="tab"
                                 href=format!("#{}", t.slug())
                                 id=format!("tab-{}", t.slug())
-                                class:active=move || tab.get() == t
-                                aria-selected=move || (tab.get() == t).to_string()
+                                class:active=move || tab.get() == t.slug()
+                                aria-selected=move || (tab.get() == t.slug()).to_string()
                             >
                                 {t.label()}
                             </a>
@@ -204,13 +206,13 @@ pub fn App() -> impl IntoView {
 /// One view, kept mounted (its form state survives a change of tab) and
 /// hidden unless its tab is chosen.
 #[component]
-fn Panel(tab: RwSignal<Tab>, which: Tab, children: Children) -> impl IntoView {
+fn Panel(tab: RwSignal<String>, which: Tab, children: Children) -> impl IntoView {
     view! {
         <section
             class="panel"
             role="tabpanel"
             id=format!("view-{}", which.slug())
-            hidden=move || tab.get() != which
+            hidden=move || tab.get() != which.slug()
         >
             {children()}
         </section>

@@ -69,7 +69,7 @@ fn snr_points(rows: &[Arc<Entry>]) -> Vec<Point> {
 
 /// The view, on the page's `tab`.
 #[component]
-pub fn DataView(tab: RwSignal<Tab>) -> impl IntoView {
+pub fn DataView(tab: RwSignal<String>) -> impl IntoView {
     view! {
         <div class="cards">
             <DataRequestCard/>
@@ -334,11 +334,11 @@ const INDICATION_COLUMNS: &[(&str, &str)] = &[
 ];
 
 #[component]
-fn Indications(tab: RwSignal<Tab>) -> impl IntoView {
+fn Indications(tab: RwSignal<String>) -> impl IntoView {
     let c = use_console();
     // Hidden, the plot keeps its points and does not look at the log (as
     // the Traffic table).
-    let shown = move || tab.get() == Tab::Data;
+    let shown = move || tab.get() == Tab::Data.slug();
     // The indications (how many, the newest INDICATION_ROWS), compared
     // by what they are (as the Traffic table's rows, and of their type: one
     // memo type for both).

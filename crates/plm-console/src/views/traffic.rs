@@ -12,7 +12,7 @@ use std::sync::Arc;
 
 /// The inspector, on the page's `tab`.
 #[component]
-pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
+pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
     let c = use_console();
     // The filter's three choices as String signals (a signal type the page
     // has, rather than one of `Filter`'s own).
@@ -26,7 +26,7 @@ pub fn TrafficView(tab: RwSignal<Tab>) -> impl IntoView {
     // Hidden, the table keeps its rows and does not even look at the log:
     // redrawing it would only hold up the host's next ACK (issue 13), and
     // its tab brings it up to date.
-    let shown = move || tab.get() == Tab::Traffic;
+    let shown = move || tab.get() == Tab::Traffic.slug();
     // Rows compared by what they are (their sequence numbers), not field
     // by field: the log only ever appends, drops or clears.
     let rows = Memo::new_with_compare(
