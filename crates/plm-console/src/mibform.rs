@@ -342,7 +342,7 @@ mod tests {
 
     #[test]
     fn every_object_round_trips_its_default_through_the_form() {
-        for o in plm_core::mib::ST7580 {
+        for o in plm_core::st7580::mib::OBJECTS {
             let got = build(o, o.default, &inputs(o, o.default));
             assert_eq!(got.as_deref(), Ok(o.default), "{}", o.name);
         }

@@ -1,13 +1,13 @@
-//! The declarative MIB description: every object of both chips with its
-//! name, index, length, access, factory default and field layout. Console
-//! forms are rendered from it, the decoder prints with it and the simulator
-//! validates with it; nothing about a MIB object is described twice.
+//! The declarative MIB description: what an object of either chip is (its
+//! name, index, length, access, factory default and field layout); each
+//! chip lists its own objects in it (`st7580::mib::OBJECTS`,
+//! `st7570::mib::OBJECTS`). Console forms are rendered from it, the
+//! decoder prints with it and the simulator validates with it; nothing
+//! about a MIB object is described twice.
 
 use crate::field::{self, Field, FieldError, Value};
 use alloc::vec::Vec;
 use core::fmt;
-
-pub use crate::st7580::mib::OBJECTS as ST7580;
 
 /// What the host may do with an object (UM0932 Table 52, R/W/E).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -82,7 +82,7 @@ fn table_9_default_timeouts() {
 
 #[test]
 fn table_52_defaults_pass_the_chip_validation_and_round_trip() {
-    for o in plm_core::mib::ST7580 {
+    for o in plm_core::st7580::mib::OBJECTS {
         assert_eq!(o.default.len(), o.len, "{}", o.name);
         o.check_value(o.default)
             .unwrap_or_else(|e| panic!("{}: {e}", o.name));

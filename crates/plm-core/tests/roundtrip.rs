@@ -369,7 +369,7 @@ fn the_mib_strategy_covers_every_object() {
         .into_iter()
         .map(|arm| arm.new_tree(&mut runner).unwrap().current().index())
         .collect();
-    let table: HashSet<u8> = mib::ST7580.iter().map(|o| o.index as u8).collect();
+    let table: HashSet<u8> = st_mib::OBJECTS.iter().map(|o| o.index as u8).collect();
     assert_eq!(indexes, table);
     assert_eq!(indexes.len(), 11, "Table 52: 00h..0Ah");
 }
@@ -407,7 +407,7 @@ proptest! {
     /// typed structs and the declarative layouts agree bit for bit.
     #[test]
     fn any_mib_value_decodes_and_keeps_its_meaningful_bits(
-        o in select(mib::ST7580),
+        o in select(st_mib::OBJECTS),
         raw in vec(any::<u8>(), 16),
     ) {
         let value = &raw[..o.len];
@@ -437,8 +437,8 @@ proptest! {
 
 #[test]
 fn every_factory_default_is_valid_and_round_trips() {
-    assert_eq!(mib::ST7580.len(), 11);
-    for o in mib::ST7580 {
+    assert_eq!(st_mib::OBJECTS.len(), 11);
+    for o in st_mib::OBJECTS {
         assert_eq!(o.default.len(), o.len, "{}", o.name);
         assert_eq!(o.check_value(o.default), Ok(()), "{}", o.name);
         let decoded = MibObject::decode(o.index as u8, o.default)

@@ -61,7 +61,7 @@ impl Chip for St7580 {
     }
 
     fn mib(&self) -> &'static [Object] {
-        crate::mib::ST7580
+        crate::st7580::mib::OBJECTS
     }
 
     fn mib_read(&self, index: u16) -> LocalFrame {
