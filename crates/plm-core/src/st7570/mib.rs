@@ -12,6 +12,8 @@ use crate::link::TicSelector;
 use crate::mib::{self as m, Object, Scope};
 use alloc::vec::Vec;
 
+mod table;
+
 /// Operating mode bits of [`Scope::write_modes`] (00A1h byte 0 b0..b2).
 pub mod modes {
     /// IDLE.
@@ -368,7 +370,7 @@ pub(super) const ZC_DELAY: &[Field] = &[
     UNUSED_B20,
 ];
 
-pub use super::mib_table::OBJECTS;
+pub use table::OBJECTS;
 
 /// The object with this index.
 pub fn object(index: u16) -> Option<&'static Object> {

@@ -14,7 +14,6 @@ pub mod fields;
 mod layout;
 pub mod mac;
 pub mod mib;
-mod mib_table;
 pub mod phy_frame;
 pub mod status;
 mod types;

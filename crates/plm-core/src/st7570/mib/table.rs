@@ -1,10 +1,10 @@
 //! Table 71: the 35 ST7570 MIB objects, each with its layout (from
-//! [`super::mib`]), length, access, factory default, write layout and
+//! [`super`]), length, access, factory default, write layout and
 //! scope. Where Table 71 and an object's own table disagree, the object's
 //! table wins (docs/protocol-notes.md): 0014h is read-only (6.5.21), the
 //! default of 0016h is 0FFFFFFFh (Table 120), of 00ACh 000000h (Table 143).
 
-use super::mib::*;
+use super::*;
 use crate::mib::{Access, Object};
 
 macro_rules! object {
