@@ -83,14 +83,27 @@ pub struct TrafficStore {
 /// What the console knows of the modem.
 #[derive(Clone, Copy)]
 pub struct ModemStore {
-    /// The last status message byte and when it came.
-    pub status: RwSignal<Option<(Instant, u8)>>,
-    /// The last BIO_ResetIndication's ResetData and when it came.
-    pub last_reset: RwSignal<Option<(Instant, u8)>>,
+    /// The last status message byte and when it came ([`stamped`]).
+    pub status: RwSignal<Option<u64>>,
+    /// The last BIO_ResetIndication's ResetData and when it came
+    /// ([`stamped`]).
+    pub last_reset: RwSignal<Option<u64>>,
     /// The value of each MIB object as last read or written.
     pub mib: RwSignal<crate::mibform::MibValues>,
     /// What an ST7570 told of its S-FSK network (the Network view).
     pub network: RwSignal<crate::network::NetworkLog>,
+}
+
+/// A byte and when it came (µs) in one u64, the time above the byte: the
+/// modem store's signals are of a type the page has rather than one of
+/// their own (docs/console.md, "Size"). Times up to 2^56 µs (2 284 years).
+pub fn stamped(at: Instant, byte: u8) -> u64 {
+    at << 8 | u64::from(byte)
+}
+
+/// The time and byte of [`stamped`].
+pub fn unstamped(v: u64) -> (Instant, u8) {
+    (v >> 8, v as u8)
 }
 
 /// The Simulator view's state.
@@ -806,7 +819,7 @@ impl Console {
                     ..
                 } => {
                     let cause = frame.data.first().copied().unwrap_or(0);
-                    self.modem.last_reset.set(Some((at, cause)));
+                    self.modem.last_reset.set(Some(stamped(at, cause)));
                 }
                 Note::Unsolicited { at, frame, .. } => {
                     if self.profile.get_untracked() == Profile::St7570 {
@@ -826,7 +839,7 @@ impl Console {
             }
         }
         if status.is_some() {
-            self.modem.status.set(status);
+            self.modem.status.set(status.map(|(at, b)| stamped(at, b)));
         }
         if !traffic.is_empty() {
             self.traffic.log.update(|log| {
@@ -858,4 +871,16 @@ enum MibOp {
     Read,
     Write(Vec<u8>),
     Erase,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stamped_byte_keeps_its_time_and_value() {
+        for (at, byte) in [(0, 0), (12_000_345, 0x3f), ((1 << 56) - 1, 0xff)] {
+            assert_eq!(unstamped(stamped(at, byte)), (at, byte));
+        }
+    }
 }

@@ -7,7 +7,7 @@ use super::widgets::{
 };
 use super::{millis, seconds, spaced};
 use crate::session::{Outcome, ACK_SAMPLES};
-use crate::stores::{refusal, use_console};
+use crate::stores::{refusal, unstamped, use_console};
 use leptos::prelude::*;
 use plm_core::field::Field;
 use plm_core::st7580::fields::{reset_data, status};
@@ -151,7 +151,7 @@ fn PingCard() -> impl IntoView {
 #[component]
 fn StatusCard() -> impl IntoView {
     let c = use_console();
-    let html_of = move || match c.modem.status.get() {
+    let html_of = move || match c.modem.status.get().map(unstamped) {
         None => "<p class=\"muted\">No status message yet: send any request.</p>".to_string(),
         Some((at, b)) => format!(
             "<p>3F {b:02X}, received at {}</p>{}",
@@ -294,7 +294,7 @@ fn ResetCard() -> impl IntoView {
             </button>
             {note("reset-result", "", message)}
             <h4>"Last BIO_ResetIndication"</h4>
-            {html(Box::new(move || match c.modem.last_reset.get() {
+            {html(Box::new(move || match c.modem.last_reset.get().map(unstamped) {
                 None => "<p class=\"muted\">None since connecting.</p>".to_string(),
                 Some((at, byte)) => format!(
                     "<p>ResetData {byte:02X}h at {}</p>{}",
