@@ -34,11 +34,10 @@ mod st7580;
 #[cfg(feature = "st7570")]
 pub use st7570_line::{decode_line, LineDecoded};
 
-use crate::field::{Field, Value};
+use crate::decode_app::AppDecoded;
 use crate::hex;
 use crate::json::{json_record, Json, Object};
 use crate::link::{Dialect, Element, GarbageReason, LocalFrame, Source, StreamDecoder};
-use alloc::format;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
@@ -105,37 +104,49 @@ json_record!(Decoded {
     warning,
 });
 
-/// A field value as JSON: numbers as numbers, enums by the manual's name,
-/// bytes as lowercase hex, "no value" as null.
-pub fn json_value(v: &Value) -> Json {
-    match v {
-        Value::Uint(n) => Json::from(*n),
-        Value::Int(n) => Json::from(*n),
-        Value::Flag(b) => Json::Bool(*b),
-        Value::Enum { name: Some(n), .. } => Json::String((*n).to_string()),
-        Value::Enum { raw, name: None } => Json::from(*raw),
-        Value::Bytes(b) => Json::String(hex::encode(b)),
-        Value::Absent => Json::Null,
-    }
-}
-
-/// One field's value in `map` under its name. A number the seed reads in
-/// a unit ([`Field::scale`]: S0 in dBµV) is given in that unit, and the
-/// raw number beside it as `NAME_raw`.
-pub(crate) fn put_value(map: &mut Object, f: &Field, v: &Value) {
-    match f.reading(v) {
-        Some(text) => {
-            map.insert(f.name, Json::Number(text));
-            map.insert(format!("{}_raw", f.name), json_value(v));
+// An application frame in this decoder's shape lives beside the shape, so
+// that `decode_app`, which `decode` uses for the frames a DL frame carries,
+// uses nothing of `decode`.
+impl AppDecoded {
+    /// The same element in the modem decoder's shape, so that one traffic
+    /// inspector (and its export) shows both: `from` is who sent it
+    /// (`host` or `board`); the command is the frame's name, the checksum
+    /// its CRC-16, and the address, frame type, broadcast flag and
+    /// direction lead its fields.
+    pub fn to_decoded(&self, from: &str) -> Decoded {
+        let mut fields = Object::new();
+        let mut put = |k: &str, v: Option<Json>| {
+            if let Some(v) = v {
+                fields.insert(k.to_string(), v);
+            }
+        };
+        put("address", self.address.clone().map(Json::String));
+        put("destination", self.destination.clone().map(Json::String));
+        put("source", self.source.clone().map(Json::String));
+        put("frame_type", self.frame_type.clone());
+        put("broadcast", self.broadcast.map(Json::Bool));
+        put("direction", self.direction.clone().map(Json::String));
+        if let Some(f) = &self.fields {
+            fields.extend(f.clone());
         }
-        None => map.insert(f.name, json_value(v)),
-    }
-}
-
-/// The named values of `data` under `layout`, in `map`.
-pub(crate) fn put_layout(map: &mut Object, layout: &'static [Field], data: &[u8]) {
-    for (f, v) in crate::mib::describe(layout, data) {
-        put_value(map, f, &v);
+        Decoded {
+            kind: self.kind.clone(),
+            from: Some(from.to_string()),
+            hex: self.hex.clone(),
+            stx: None,
+            length: self.length,
+            code: None,
+            command: self.command.clone().or_else(|| self.frame_type.clone()),
+            layer: None,
+            checksum: self.crc,
+            checksum_ok: self.crc_ok,
+            fields: Some(fields),
+            error: self.error.clone(),
+            reason: None,
+            repeat: None,
+            after_t_ack: None,
+            warning: None,
+        }
     }
 }
 

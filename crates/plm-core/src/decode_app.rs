@@ -21,7 +21,7 @@
 use crate::app::hid::{self, Hid};
 use crate::app::service::{self, Service};
 use crate::app::{AppFrame, FrameType, LineFrame, Message, UsartDecoder, UsartElement};
-use crate::decode::put_layout;
+use crate::field_json::put_layout;
 use crate::hex;
 use crate::json::{json_record, Json, Object};
 use crate::st7580;
@@ -104,47 +104,6 @@ impl AppDecoded {
             crc: None,
             crc_ok: None,
             error: None,
-        }
-    }
-
-    /// The same element in the modem decoder's shape, so that one traffic
-    /// inspector (and its export) shows both: `from` is who sent it
-    /// (`host` or `board`); the command is the frame's name, the checksum
-    /// its CRC-16, and the address, frame type, broadcast flag and
-    /// direction lead its fields.
-    pub fn to_decoded(&self, from: &str) -> crate::decode::Decoded {
-        let mut fields = Object::new();
-        let mut put = |k: &str, v: Option<Json>| {
-            if let Some(v) = v {
-                fields.insert(k.to_string(), v);
-            }
-        };
-        put("address", self.address.clone().map(Json::String));
-        put("destination", self.destination.clone().map(Json::String));
-        put("source", self.source.clone().map(Json::String));
-        put("frame_type", self.frame_type.clone());
-        put("broadcast", self.broadcast.map(Json::Bool));
-        put("direction", self.direction.clone().map(Json::String));
-        if let Some(f) = &self.fields {
-            fields.extend(f.clone());
-        }
-        crate::decode::Decoded {
-            kind: self.kind.clone(),
-            from: Some(from.to_string()),
-            hex: self.hex.clone(),
-            stx: None,
-            length: self.length,
-            code: None,
-            command: self.command.clone().or_else(|| self.frame_type.clone()),
-            layer: None,
-            checksum: self.crc,
-            checksum_ok: self.crc_ok,
-            fields: Some(fields),
-            error: self.error.clone(),
-            reason: None,
-            repeat: None,
-            after_t_ack: None,
-            warning: None,
         }
     }
 

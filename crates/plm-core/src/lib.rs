@@ -49,6 +49,7 @@ pub mod chip;
 pub mod decode;
 pub mod decode_app;
 pub mod field;
+mod field_json;
 pub mod file;
 pub mod hex;
 pub mod json;

@@ -8,8 +8,9 @@
 //! written or read (Access layer mode, Operating mode) and 0000h (FIMA,
 //! LIMA), or from [`super::Decoder::fix_layer`], which wins.
 
-use super::{put_hex, put_value, Decoded};
+use super::{put_hex, Decoded};
 use crate::field::{Field, Value};
+use crate::field_json::put_value;
 use crate::json::{Json, Object};
 use crate::link::{LocalFrame, Source};
 use crate::mib::Object as MibObject;

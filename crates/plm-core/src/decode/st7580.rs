@@ -3,7 +3,8 @@
 //! MIB_ReadRequest before it, and the application frame a DL payload
 //! carries ([`crate::decode_app`]) under `app` in `fields`.
 
-use super::{put_hex, put_layout, Decoded};
+use super::{put_hex, Decoded};
+use crate::field_json::put_layout;
 use crate::json::{Json, Object};
 use crate::link::{LocalFrame, Source};
 use crate::st7580::code::CommandType;
