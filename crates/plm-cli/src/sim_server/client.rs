@@ -13,7 +13,6 @@
 //! - When it goes, its port is purged ([`purge`]): what it sent and the
 //!   modem has not read is lost, as on a real port.
 
-use super::event_loop::Wake;
 use crate::rfc2217::{self, Action, Refusal};
 use plm_sim::Ports;
 use std::io::{ErrorKind, Read, Write};
@@ -21,6 +20,23 @@ use std::net::{SocketAddr, TcpStream};
 use std::sync::mpsc::Sender;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Duration;
+
+/// What wakes the loop ([`super::event_loop`]): a client's threads send
+/// `Data` and `Closed`, the listeners `Accepted`, a stopper `Stop`.
+pub(super) enum Wake {
+    /// A client connected to node `node`'s port.
+    Accepted {
+        node: usize,
+        stream: TcpStream,
+        peer: SocketAddr,
+    },
+    /// Bytes from connection `conn`.
+    Data { conn: u64, chunk: Chunk },
+    /// Connection `conn` closed or failed.
+    Closed { conn: u64, why: String },
+    /// Ctrl-C, SIGTERM or [`super::event_loop::Stopper::stop`].
+    Stop,
+}
 
 /// The simulated UART's transmit buffer: bytes a client may have written
 /// and the modem not yet received (4 KiB, the transmit buffer of Linux's

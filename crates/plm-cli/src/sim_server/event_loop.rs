@@ -13,7 +13,7 @@
 //! timed wait (unlike a socket's read timeout, rounded to the kernel's
 //! scheduler tick) ends within some tens of microseconds of the deadline.
 
-use super::client::{self, Chunk, Client, Purge};
+use super::client::{self, Client, Purge, Wake};
 use plm_sim::Ports;
 use std::collections::VecDeque;
 use std::io::Write;
@@ -24,22 +24,6 @@ use std::time::{Duration, Instant};
 /// Baud rates the BR0/BR1 pins select: UM0932 3.1 for the ST7580, the
 /// same four in the ST7570 UM's Table 9.
 pub const RATES: &[u32] = &plm_core::link::BAUD_RATES;
-
-/// What wakes the loop.
-pub(super) enum Wake {
-    /// A client connected to node `node`'s port.
-    Accepted {
-        node: usize,
-        stream: TcpStream,
-        peer: SocketAddr,
-    },
-    /// Bytes from connection `conn`.
-    Data { conn: u64, chunk: Chunk },
-    /// Connection `conn` closed or failed.
-    Closed { conn: u64, why: String },
-    /// Ctrl-C, SIGTERM or [`Stopper::stop`].
-    Stop,
-}
 
 /// Stops a running [`Served`] loop from another thread.
 #[derive(Clone)]
