@@ -4,6 +4,7 @@
 //! fresh machine needs only Rust and `cargo xtask serve` or `cargo xtask test`.
 
 mod bench;
+mod circles;
 #[cfg(test)]
 mod doc_toc;
 mod fuzz;
@@ -26,6 +27,7 @@ commands:
   test [--dry-run] [--no-setup]
                              setup, then every test suite; stops at the first failure
   bench                      run the benchmarks; each prints its own figures
+  circles                    fail on a module circle in any crate (a -> b -> a)
   fuzz [TARGET] [--time S]   fuzz TARGET (all in turn when none) for S seconds
                              each (default 60); crashes go to fuzz/regressions/
   dist                       build the release console into dist/
@@ -95,6 +97,10 @@ fn dispatch(args: &[String]) -> Result {
         "bench" => {
             Options::parse(rest, &[], &[])?;
             bench::run()
+        }
+        "circles" => {
+            Options::parse(rest, &[], &[])?;
+            circles::run()
         }
         "help" | "-h" | "--help" => {
             print!("{USAGE}");

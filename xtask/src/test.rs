@@ -2,7 +2,7 @@
 //! failure. `.ci/run` runs exactly this.
 
 use crate::util::{root, run_steps, Cmd, Result, Step};
-use crate::{serve, setup};
+use crate::{circles, serve, setup};
 
 /// Runs every suite; with `dry_run`, lists them (and the setup plan) only;
 /// with `no_setup`, trusts that the tools are already there.
@@ -30,6 +30,7 @@ fn cargo(args: &[&str]) -> Cmd {
 fn suites() -> Vec<Step> {
     let root = root();
     let mut steps = vec![
+        Step::new("module circles", "cargo xtask circles", circles::run),
         Step::cmd("format", cargo(&["fmt", "--all", "--", "--check"])),
         Step::cmd(
             "clippy",
