@@ -2,13 +2,13 @@
 //! temperature, SNR), read now, dimming, clock, GPIO, parameter groups,
 //! ballast reset, and on a simulated street the faults a demo needs.
 
-use super::street::{computer_clock, dimming_value};
+use super::street::{computer_clock, dimming_value, key_address};
 use super::widgets::{button, escape, html, on_event, signal, text_input};
 use crate::stores::use_console;
 use crate::transport::LampAction;
 use leptos::prelude::*;
 use plm_core::app::service::Service;
-use plm_core::app::{Address, Message, Request};
+use plm_core::app::{Message, Request};
 
 /// Eight checkboxes, IO7 first, bound to the bits of `mask`.
 fn pin_boxes(mask: RwSignal<u32>, id: &'static str) -> impl IntoView {
@@ -109,9 +109,9 @@ fn state_html(lamp: Option<&crate::street::Lamp>) -> String {
     html
 }
 
-/// The page of the lamp `focus` names.
+/// The page of the lamp `focus` names (by its row key).
 #[component]
-pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
+pub fn LampPanel(focus: RwSignal<Option<u64>>) -> impl IntoView {
     let street = use_console().street;
     let note = signal(None::<String>);
     let level = signal(String::from("50"));
@@ -121,7 +121,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     let group = signal(2u32);
     let params = signal(String::new());
     let ask = move |m: Message, what: &'static str| {
-        let Some(a) = focus.get_untracked() else {
+        let Some(a) = focus.get_untracked().map(key_address) else {
             return;
         };
         note.set(Some(format!("{what}…")));
@@ -154,7 +154,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
         }
     };
     let sim = move |action: LampAction| {
-        let Some(a) = focus.get_untracked() else {
+        let Some(a) = focus.get_untracked().map(key_address) else {
             return;
         };
         street.act(|s| {
@@ -167,7 +167,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
     view! {
         <aside class="details lamp" id="lamp-panel">
             // Rebuilt when another lamp is chosen; its state as it is read.
-            {move || focus.get().map(|address| view! {
+            {move || focus.get().map(key_address).map(|address| view! {
                         <div class="lamp-head">
                             <h3>{format!("Lamp {address}")}</h3>
                             {button("lamp-close", "✕", "close this lamp's page", move || focus.set(None))}
@@ -189,7 +189,7 @@ pub fn LampPanel(focus: RwSignal<Option<Address>>) -> impl IntoView {
                             {button("lamp-dim", "Dim", "", move || {
                                 match dimming_value(&level.get_untracked()) {
                                     Ok(v) => {
-                                        let a = focus.get_untracked();
+                                        let a = focus.get_untracked().map(key_address);
                                         let r = street.act(|s| s.dim(a, v));
                                         note.set(Some(match r { Ok(()) => format!("dimming {v} % sent"), Err(e) => format!("nothing sent: {e}") }));
                                     }

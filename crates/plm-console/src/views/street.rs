@@ -22,7 +22,9 @@ pub fn StreetView() -> impl IntoView {
     // as the page has many, not one of its own type (docs/console.md, "Size").
     let sort = signal(String::from("address"));
     let selected = street.selected;
-    let focus = signal(None::<Address>);
+    // The lamp whose page is open, by its row key: an Option<u64> signal
+    // as the page has (docs/console.md, "Size").
+    let focus = signal(None::<u64>);
     let message = signal(None::<String>);
     // The rows shown, sorted and filtered; the table keys its lines by
     // address and each line follows its own lamp, so a reading redraws one
@@ -121,7 +123,7 @@ pub fn StreetView() -> impl IntoView {
                                 // The selection box's cell does not open the lamp.
                                 if closest(&ev, "td.pick").is_none() {
                                     if let Some(a) = row_address(&ev) {
-                                        focus.set(Some(a));
+                                        focus.set(Some(row_key(a)));
                                     }
                                 }
                             })
@@ -153,7 +155,7 @@ pub fn StreetView() -> impl IntoView {
                                         <tr
                                             data-address=address.to_string()
                                             class:trouble=move || row.with(|r| r.first().is_some_and(|r| r.trouble))
-                                            class:selected=move || focus.get() == Some(address)
+                                            class:selected=move || focus.get() == Some(key)
                                             inner_html=move || {
                                                 let picked = selected.with(|s| s.contains(&address));
                                                 row.with(|r| row_html(r.first(), picked))
@@ -307,7 +309,7 @@ fn GroupActions(
 }
 
 #[component]
-fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
+fn Alerts(focus: RwSignal<Option<u64>>) -> impl IntoView {
     let street = use_console().street;
     view! {
         {move || (street.alerts.with(|a| !a.is_empty())).then(|| view! {
@@ -321,7 +323,7 @@ fn Alerts(focus: RwSignal<Option<Address>>) -> impl IntoView {
                         let address = r.alert.address;
                         view! {
                             <li>
-                                <a href="#street" on:click=on_click(move |_| focus.set(Some(address)))>{address.to_string()}</a>
+                                <a href="#street" on:click=on_click(move |_| focus.set(Some(row_key(address))))>{address.to_string()}</a>
                                 {format!(" {} (at {})", r.alert.what, r.wall)}
                             </li>
                         }
@@ -361,13 +363,13 @@ fn row_address(ev: &web_sys::Event) -> Option<Address> {
 }
 
 /// A board address as the key of its row (6 bytes in a u64), and back.
-fn row_key(a: Address) -> u64 {
+pub(super) fn row_key(a: Address) -> u64 {
     let mut k = [0; 8];
     k[2..].copy_from_slice(&a.0);
     u64::from_be_bytes(k)
 }
 
-fn key_address(key: u64) -> Address {
+pub(super) fn key_address(key: u64) -> Address {
     let mut a = [0; 6];
     a.copy_from_slice(&key.to_be_bytes()[2..]);
     Address(a)
