@@ -42,7 +42,8 @@ pub const STOP_RISK: f64 = 1e-5;
 pub const CAPTURES: [f64; 6] = [0.0, 0.387_298, 0.547_723, 0.670_820, 0.774_597, 0.866_025];
 
 /// The share of the belief in each capture value that moves to the next
-/// lower one after each frame ([`Estimate::observe`]).
+/// lower one after each frame, and the share of each count's belief
+/// spread over every capture value ([`Estimate::observe`]).
 pub const CAPTURE_FADES: f64 = 0.1;
 
 /// Boards up to which the chance of a frame's count is exact.
@@ -173,13 +174,19 @@ impl Estimate {
         // The strongest boards win the captures, so they are found
         // first: the boards left capture less and less. Each frame, a
         // share of the belief in each capture value moves to the next
-        // lower one, so that a line that captured early cannot make a
-        // crowd of weaker boards look like a few.
+        // lower one, and a share of each count's belief is spread over
+        // every capture value (a line whose requests collide or lag looks
+        // like one that stopped capturing), so that a line that captured
+        // early cannot make a crowd look like a few.
         for row in self.belief.iter_mut() {
             for k in 1..CAPTURES.len() {
                 let down = row[k] * CAPTURE_FADES;
                 row[k] -= down;
                 row[k - 1] += down;
+            }
+            let spread = row.iter().sum::<f64>() * CAPTURE_FADES / CAPTURES.len() as f64;
+            for p in row.iter_mut() {
+                *p = *p * (1.0 - CAPTURE_FADES) + spread;
             }
         }
     }
