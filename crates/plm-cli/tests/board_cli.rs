@@ -208,6 +208,16 @@ fn discover_status_and_dim_a_street() {
     assert_eq!(lamps, want, "{found:?}");
     assert!(found.err.contains("3 boards found"), "{}", found.err);
 
+    // With a round of the older rule after it: every board, each once.
+    let older = board(
+        &mut server,
+        &dir,
+        "older",
+        &["discover", "--older-rule", "--json"],
+    );
+    assert_eq!(older.code, Some(0), "{older:?}");
+    assert_eq!(json_lines(&older.out).len(), 3, "{older:?}");
+
     // `status all`: the street found again and every lamp read, one
     // JSON object each.
     let all = board(

@@ -8,7 +8,7 @@
 
 use super::Failure;
 use crate::port::Port;
-use plm_core::app::discovery::DiscoveryConfig;
+use plm_core::app::discovery::{DiscoveryConfig, Rounds};
 use plm_core::app::sweep::Round;
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Listener, Message,
@@ -164,11 +164,13 @@ impl Driver {
         })
     }
 
-    /// Discovery (plm-core's rule): each board is handed to `found` the
-    /// first time it is heard.
+    /// Discovery (plm-core's rule), then with `older_rule` a round of the
+    /// older rule: each board is handed to `found` the first time it is
+    /// heard.
     pub fn discover(
         &mut self,
         config: DiscoveryConfig,
+        older_rule: bool,
         mut found: impl FnMut(Address, Discovered),
     ) -> Result<Discovery, Failure> {
         let (mut d, first) = Discovery::start(self.now(), config);
@@ -180,6 +182,18 @@ impl Driver {
             }
             told = d.found().len();
         })?;
+        if older_rule {
+            // A round of rule 1 for boards still on it (protocol notes,
+            // "Discovery").
+            let (mut r, first) = Rounds::start(self.now(), config.session, 1, 3);
+            self.submit(first)?;
+            self.listen(&mut r, |_| {})?;
+            for (a, info) in r.found() {
+                if d.record_found(*a, *info) {
+                    found(*a, *info);
+                }
+            }
+        }
         Ok(d)
     }
 

@@ -12,14 +12,19 @@ use serde_json::{json, Map, Value};
 use std::collections::BTreeMap;
 
 /// Discovers the boards; prints each as it is found.
-pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
+pub fn discover(
+    d: &mut Driver,
+    config: DiscoveryConfig,
+    older_rule: bool,
+    json: bool,
+) -> Result<u8, Failure> {
     tell!(
         "plm board: discovering (about {} boards expected; it ends when the line has been \
          quiet long enough to be sure)",
         config.guess
     );
     let started = std::time::Instant::now();
-    let found = d.discover(config, |address, info| {
+    let found = d.discover(config, older_rule, |address, info| {
         if json {
             say!(
                 "{}",
@@ -64,7 +69,7 @@ pub fn discover(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u
 pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
     let started = std::time::Instant::now();
     tell!("plm board: discovering, then reading every lamp found");
-    let found = d.discover(config, |_, _| {})?.found().to_vec();
+    let found = d.discover(config, false, |_, _| {})?.found().to_vec();
     let reads = RoundConfig {
         read: ReadConfig {
             timing: config.timing,

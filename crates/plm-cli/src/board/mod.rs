@@ -284,9 +284,8 @@ fn dispatch(args: BoardArgs) -> Result<u8, Failure> {
     match &args.command {
         BoardCommand::Discover { guess, older_rule } => {
             let mut d = connect(&args)?;
-            let mut config = DiscoveryConfig::new(session(), *guess as usize);
-            config.older_rule = *older_rule;
-            info::discover(&mut d, config, args.json)
+            let config = DiscoveryConfig::new(session(), *guess as usize);
+            info::discover(&mut d, config, *older_rule, args.json)
         }
         BoardCommand::Status { node, guess } => {
             let mut d = connect(&args)?;

@@ -267,7 +267,7 @@ pub fn run(args: &BoardArgs, r: &RfuArgs) -> Result<u8, Failure> {
 /// `--all`: the boards a discovery finds.
 fn find_boards(d: &mut Driver) -> Result<Vec<Address>, Failure> {
     tell!("plm board: discovering the boards to update");
-    let found = d.discover(DiscoveryConfig::new(session(), 12), |a, info| {
+    let found = d.discover(DiscoveryConfig::new(session(), 12), false, |a, info| {
         tell!("plm board: found {a} (firmware {})", info.firmware);
     })?;
     Ok(found.found().iter().map(|(a, _)| *a).collect())

@@ -16,7 +16,8 @@
 //!    [`STOP_RISK`].
 //!
 //! Rule 1 ([`rounds`]) is the older rule, kept so that a board still on
-//! it is found (`older_rule`). Sans-IO: the caller sends the requests it
+//! it is found (`plm board discover --older-rule` runs its [`Rounds`]
+//! after a discovery). Sans-IO: the caller sends the requests it
 //! is given and hands over what boards say.
 
 pub mod estimate;
@@ -120,8 +121,6 @@ pub struct DiscoveryConfig {
     pub guess: usize,
     /// The line's timing.
     pub timing: Timing,
-    /// After rule 2, a round of rule 1 for boards still on it.
-    pub older_rule: bool,
     /// Frames at most.
     pub max_frames: u8,
 }
@@ -133,7 +132,6 @@ impl DiscoveryConfig {
             session,
             guess,
             timing: Timing::BPSK,
-            older_rule: false,
             max_frames: MAX_FRAMES,
         }
     }
@@ -155,8 +153,6 @@ pub struct Discovery {
     to_silence: VecDeque<Address>,
     /// Boards found, in the order they were first heard.
     found: Vec<(Address, Discovered)>,
-    /// Rule 1's round, at the end.
-    older: Option<Rounds>,
     done: bool,
 }
 
@@ -183,7 +179,6 @@ impl Discovery {
             new_in_frame: 0,
             to_silence: VecDeque::new(),
             found: known,
-            older: None,
             done: false,
         };
         let r = d.next_frame(now);
@@ -211,15 +206,9 @@ impl Discovery {
     }
 
     /// A frame that came unasked: a discovery reply records its board.
-    /// Returns the acknowledgement to send, which only rule 1 has.
+    /// Returns the acknowledgement to send: none, rule 2 acknowledges
+    /// nothing (rule 1, [`Rounds`], does).
     pub fn on_message(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
-        if let Some(r) = self.older.as_mut() {
-            let ack = r.on_message(address, message);
-            if let Some(&(a, d)) = r.found().iter().find(|(a, _)| *a == address) {
-                self.record(a, d);
-            }
-            return ack;
-        }
         if let Message::Service(Service::DiscoverReply(d)) = message {
             if self.record(address, *d) {
                 self.new_in_frame += 1;
@@ -231,6 +220,12 @@ impl Discovery {
             }
         }
         None
+    }
+
+    /// A board found otherwise (by the older rule, after this discovery):
+    /// recorded among those found; whether it is new.
+    pub fn record_found(&mut self, address: Address, d: Discovered) -> bool {
+        self.record(address, d)
     }
 
     /// Records what a board said; whether it is new.
@@ -249,11 +244,7 @@ impl Discovery {
 
     /// When [`Discovery::handle_timeout`] is due.
     pub fn poll_timeout(&self) -> Option<Instant> {
-        match &self.older {
-            _ if self.done => None,
-            Some(r) => r.poll_timeout(),
-            None => Some(self.frame_ends),
-        }
+        (!self.done).then_some(self.frame_ends)
     }
 
     /// The frame is over: the next request, or `None` when the
@@ -262,11 +253,6 @@ impl Discovery {
         if self.done {
             return None;
         }
-        if let Some(r) = self.older.as_mut() {
-            let next = r.handle_timeout(now);
-            self.done = r.is_done();
-            return next;
-        }
         if now < self.frame_ends {
             return None;
         }
@@ -274,11 +260,6 @@ impl Discovery {
         let sure = self.estimate.anybody() < STOP_RISK;
         if !sure && self.frames < self.config.max_frames {
             return Some(self.next_frame(now));
-        }
-        if self.config.older_rule {
-            let (r, first) = Rounds::start(now, self.config.session, 1, 3);
-            self.older = Some(r);
-            return Some(first);
         }
         self.done = true;
         None

@@ -2,7 +2,7 @@
 //! unasked (discovery, reads in slots): one trait, so that each driver
 //! (`plm board`, the simulated street) writes its loop over them once.
 
-use super::discovery::Discovery;
+use super::discovery::{Discovery, Rounds};
 use super::frame::{Address, AppFrame};
 use super::message::Message;
 use super::read_all::ReadAll;
@@ -23,6 +23,21 @@ pub trait Listener {
 }
 
 impl Listener for Discovery {
+    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+        self.on_message(address, message)
+    }
+    fn due(&self) -> Option<Instant> {
+        self.poll_timeout()
+    }
+    fn tick(&mut self, now: Instant) -> Option<Request> {
+        self.handle_timeout(now)
+    }
+    fn done(&self) -> bool {
+        self.is_done()
+    }
+}
+
+impl Listener for Rounds {
     fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
         self.on_message(address, message)
     }
