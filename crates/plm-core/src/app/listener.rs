@@ -22,48 +22,31 @@ pub trait Listener {
     fn done(&self) -> bool;
 }
 
-impl Listener for Discovery {
-    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
-        self.on_message(address, message)
-    }
-    fn due(&self) -> Option<Instant> {
-        self.poll_timeout()
-    }
-    fn tick(&mut self, now: Instant) -> Option<Request> {
-        self.handle_timeout(now)
-    }
-    fn done(&self) -> bool {
-        self.is_done()
-    }
+/// The trait over the engines' own methods: `on_message`,
+/// `poll_timeout`, `handle_timeout`, `is_done`.
+macro_rules! listener {
+    ($engine:ty, $hear:expr) => {
+        impl Listener for $engine {
+            fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+                $hear(self, address, message)
+            }
+            fn due(&self) -> Option<Instant> {
+                self.poll_timeout()
+            }
+            fn tick(&mut self, now: Instant) -> Option<Request> {
+                self.handle_timeout(now)
+            }
+            fn done(&self) -> bool {
+                self.is_done()
+            }
+        }
+    };
 }
 
-impl Listener for Rounds {
-    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
-        self.on_message(address, message)
-    }
-    fn due(&self) -> Option<Instant> {
-        self.poll_timeout()
-    }
-    fn tick(&mut self, now: Instant) -> Option<Request> {
-        self.handle_timeout(now)
-    }
-    fn done(&self) -> bool {
-        self.is_done()
-    }
-}
-
-impl Listener for ReadAll {
-    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
-        self.on_message(address, message);
-        None
-    }
-    fn due(&self) -> Option<Instant> {
-        self.poll_timeout()
-    }
-    fn tick(&mut self, now: Instant) -> Option<Request> {
-        self.handle_timeout(now)
-    }
-    fn done(&self) -> bool {
-        self.is_done()
-    }
-}
+listener!(Discovery, Discovery::on_message);
+listener!(Rounds, Rounds::on_message);
+// A read in slots answers nothing.
+listener!(ReadAll, |r: &mut ReadAll, a, m| {
+    r.on_message(a, m);
+    None
+});
