@@ -280,7 +280,7 @@ impl Discovery {
         self.plan
     }
 
-    /// How many boards it believes are left to find (the mean of its
+    /// How many boards it believes are left to find (the median of its
     /// belief).
     pub fn left(&self) -> f64 {
         self.estimate.left()
