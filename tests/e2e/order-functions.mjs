@@ -17,21 +17,10 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { leb } from './short-names.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const wasmOpt = path.join(here, 'node_modules/.bin/wasm-opt');
-
-/** Unsigned LEB128 (WebAssembly core spec 5.2.2). */
-function leb(n) {
-  const out = [];
-  do {
-    let b = n & 0x7f;
-    n = Math.floor(n / 128);
-    if (n) b |= 0x80;
-    out.push(b);
-  } while (n);
-  return Buffer.from(out);
-}
 
 /** The module's sections: id, where it begins, where its contents do, end. */
 function sections(wasm) {

@@ -13,7 +13,7 @@
 // export (5.5.10) only when the glue never writes it in quotes.
 
 /** Unsigned LEB128 (WebAssembly core spec 5.2.2). */
-function leb(n) {
+export function leb(n) {
   const out = [];
   do {
     let b = n & 0x7f;
