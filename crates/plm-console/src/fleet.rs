@@ -3,6 +3,7 @@
 //! natively.
 
 use crate::street::Lamp;
+use plm_core::app::energy::Meter;
 use plm_core::app::hid::LampState;
 use plm_core::app::Address;
 use plm_core::json::{self, Json};
@@ -15,6 +16,7 @@ pub const COLUMNS: &[(&str, &str)] = &[
     ("state", "Lamp"),
     ("dimming", "Dimming %"),
     ("power", "Power W"),
+    ("energy", "Energy Wh (est.)"),
     ("bus_voltage", "Bus V"),
     ("lamp_voltage", "Lamp V"),
     ("supply_voltage", "Supply V"),
@@ -44,6 +46,7 @@ impl Row {
     /// The row of `lamp`; `now` for how long ago it answered.
     pub fn of(lamp: &Lamp, now: Instant) -> Row {
         let b = lamp.ballast;
+        let watched = lamp.energy.watched() > 0;
         let state = match (&lamp.unreachable, lamp.state()) {
             (Some(_), _) => "UNREACHABLE".to_string(),
             (None, Some(s)) => s.name().to_string(),
@@ -60,6 +63,7 @@ impl Row {
             numbers: vec![
                 ("dimming", lamp.dimming.map(i64::from)),
                 ("power", b.map(|b| i64::from(b.lamp_power))),
+                ("energy", watched.then(|| lamp.energy.watt_hours() as i64)),
                 ("bus_voltage", b.map(|b| i64::from(b.bus_voltage))),
                 ("lamp_voltage", b.map(|b| i64::from(b.lamp_voltage))),
                 ("supply_voltage", b.map(|b| i64::from(b.supply_voltage))),
@@ -67,6 +71,11 @@ impl Row {
                 ("hours", b.map(|b| i64::from(b.lifetime_hours))),
                 ("power_ons", b.map(|b| i64::from(b.power_ons))),
                 ("snr", lamp.snr.map(i64::from)),
+                // Not a column: the span the estimate covers, in the JSON.
+                (
+                    "energy_watched_s",
+                    watched.then(|| (lamp.energy.watched() / 1_000_000) as i64),
+                ),
                 (
                     "last_seen",
                     lamp.last_seen
@@ -169,6 +178,25 @@ pub fn to_json(rows: &[Row]) -> String {
     Json::Array(v).pretty()
 }
 
+/// The street's energy as the console estimated it, in words: the sum of
+/// its lamps' (plm_core::app::energy), and over how long it was watched.
+pub fn street_energy<'a>(lamps: impl Iterator<Item = &'a Lamp>) -> String {
+    let mut street = Meter::default();
+    lamps.for_each(|l| street.add(&l.energy));
+    let tenths = street.tenths_of_watt_hours();
+    let seconds = street.watched() / 1_000_000;
+    let span = if seconds < 120 {
+        format!("{seconds} s")
+    } else {
+        format!("{} min", seconds / 60)
+    };
+    format!(
+        "Energy: {}.{} Wh over the {span} this console watched (estimated from its power readings: the boards keep no energy counter)",
+        tenths / 10,
+        tenths % 10
+    )
+}
+
 /// How a lamp state reads in the table's colours.
 pub fn state_class(state: &str) -> &'static str {
     match state {
@@ -214,7 +242,7 @@ mod tests {
         assert_eq!(rows.iter().filter(|r| r.matches("trouble")).count(), 1);
         let csv = to_csv(&rows);
         let lines: Vec<&str> = csv.split("\r\n").collect();
-        assert_eq!(lines[0], "Address,Firmware,Lamp,Dimming %,Power W,Bus V,Lamp V,Supply V,Temp °C,Hours,Power-ons,SNR dB,Last seen s");
+        assert_eq!(lines[0], "Address,Firmware,Lamp,Dimming %,Power W,Energy Wh (est.),Bus V,Lamp V,Supply V,Temp °C,Hours,Power-ons,SNR dB,Last seen s");
         assert!(
             lines[1].starts_with("0080e1000002,,FAILURE,,0,"),
             "{}",
@@ -230,5 +258,25 @@ mod tests {
         };
         assert_eq!(json[2].get("power"), Some(&Json::Int(150)));
         assert_eq!(json[0].get("trouble"), Some(&Json::Bool(true)));
+        assert_eq!(json[0].get("energy"), Some(&Json::Null), "never watched");
+    }
+
+    #[test]
+    fn energy_follows_the_readings() {
+        let mut a = lamp(1, 150, 6);
+        let mut b = lamp(2, 100, 6);
+        for m in 0..=30u64 {
+            a.energy.record(m * 60_000_000, 150);
+            b.energy.record(m * 60_000_000, 100);
+        }
+        let row = Row::of(&a, 0);
+        assert_eq!(row.number("energy"), Some(75));
+        assert_eq!(row.number("energy_watched_s"), Some(1800));
+        assert!(to_csv(&[row]).contains(",150,75,"));
+        assert!(
+            street_energy([a, b].iter()).starts_with("Energy: 125.0 Wh over the 30 min"),
+            "{}",
+            street_energy([lamp(1, 1, 6)].iter())
+        );
     }
 }

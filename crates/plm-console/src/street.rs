@@ -13,6 +13,7 @@ pub use campaign::Campaign;
 use crate::session::{Budget, Pacer};
 use crate::transport::{LinkState, Transport};
 use plm_core::app::discovery::DiscoveryConfig;
+use plm_core::app::energy::Meter;
 use plm_core::app::hid::{self, Hid, LampState};
 use plm_core::app::service::{Clock, Discovered, Service};
 use plm_core::app::sweep::{Known, Reading, Round, RoundConfig};
@@ -68,6 +69,8 @@ pub struct Lamp {
     pub unreachable: Option<String>,
     /// Recent readings, oldest first.
     pub history: VecDeque<Sample>,
+    /// Its energy, estimated from every power reading taken.
+    pub energy: Meter,
 }
 
 impl Lamp {
@@ -754,6 +757,7 @@ impl StreetSession {
         let lamp = self.lamp(a);
         let was = lamp.state();
         lamp.ballast = Some(b);
+        lamp.energy.record(now, b.lamp_power);
         let snr = lamp.snr;
         lamp.history.push_back(Sample {
             at: now,

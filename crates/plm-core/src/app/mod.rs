@@ -13,6 +13,7 @@
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
 //!   USART or a bare ST7580; [`discovery`]: finding the boards on a line;
 //!   [`read_all`]: reading many boards in slots.
+//! - [`energy`]: a lamp's energy estimated from its power readings.
 //! - [`rfu`]: remote firmware update, the layouts of its commands;
 //!   [`update`]: the engine that updates one board or a street.
 //!
@@ -22,6 +23,7 @@
 pub mod concentrator;
 pub mod crc;
 pub mod discovery;
+pub mod energy;
 pub mod error;
 pub mod frame;
 pub mod hid;
