@@ -64,6 +64,10 @@ pub fn StreetView() -> impl IntoView {
                 {button("street-export-json", "Export JSON", "", move || export(true))}
             </div>
             <p class="muted" id="street-protocol">"Discover and Firmware update need boards that speak this console's board protocol (docs/board-protocol.md), as the simulated ones do; a board on ST's own firmware answers only the manual's commands."</p>
+            <p class="muted" id="street-energy">{move || {
+                street.version.track();
+                street.with_fleet(|f| fleet::street_energy(f.values()))
+            }}</p>
             <GroupActions selected=selected message=message/>
             {move || (message.with(|m| m.is_some())).then(|| view! {
                 {super::widgets::note("street-message", "message", message)}
