@@ -10,6 +10,10 @@
 //! Windows write one), UTF-16 and UTF-32 (told by their byte order marks),
 //! bytes that are not UTF-8 and NUL bytes are refused, each in words that
 //! say where.
+//!
+//! [`poles`]: the pole list, which lamp stands where along the street.
+
+pub mod poles;
 
 use alloc::format;
 use alloc::string::String;

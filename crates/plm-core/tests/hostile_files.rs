@@ -326,3 +326,29 @@ fn sealed_image() -> Vec<u8> {
     image::seal(&mut b, Release { major: 2, minor: 1 });
     b
 }
+
+#[test]
+fn a_pole_list_is_refused_in_words() {
+    // One pole whose name is quoted: no prefix of it is a pole list.
+    check("pole list", br#"0080e1000001,"P1""#, file::poles::parse);
+}
+
+#[test]
+fn a_pole_list_of_many_short_lines_is_read_quickly() {
+    // The most lines the bound lets in, each checked against every one
+    // before it (a duplicate, a position going back).
+    let mut text = String::new();
+    let mut n = 0u64;
+    while text.len() + 20 < file::poles::POLE_LIST_MAX {
+        text.push_str(&format!("{},{}\n", Address::from_u64(n), n % 10));
+        n += 1;
+    }
+    let start = Instant::now();
+    let poles = file::poles::parse(text.as_bytes()).expect("a list within the bound");
+    assert_eq!(poles.len() as u64, n);
+    assert!(
+        start.elapsed() < Duration::from_secs(2),
+        "{:?}",
+        start.elapsed()
+    );
+}
