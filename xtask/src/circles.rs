@@ -27,18 +27,8 @@ use std::path::Path;
 /// Remove an entry once its edge is gone (the check says when); nothing
 /// is added here.
 const ALLOWED: &[(&str, &str, &str)] = &[
-    // The stores format with the views' `describe_line_event`.
-    ("plm-console", "stores", "views::simulator"),
-    // `page_now_us` lives in the stores, which use `wake` and `transport`.
-    ("plm-console", "wake", "stores"),
-    ("plm-console", "transport::webserial", "stores"),
-    // `app::Tab` is named by the views that switch tabs.
-    ("plm-console", "views::data", "app"),
-    ("plm-console", "views::traffic", "app"),
     // The lamp page takes the street page's formatters.
     ("plm-console", "views::lamp", "views::street"),
-    // `network` takes a formatter (`fixed`) from `views`.
-    ("plm-console", "network", "views"),
 ];
 
 /// Checks every crate of the workspace (`crates/*` and `xtask`).

@@ -17,8 +17,9 @@
 //!   `[[writtenMs, linkMs, pageMs], …]`, `writtenMs` on the page's clock
 //!   (`performance.now()`) when the tick that wrote the ACK began.
 
+use crate::clock::page_now_us;
 use crate::session::{Outcome, Spread};
-use crate::stores::{page_now_us, Console};
+use crate::stores::Console;
 use js_sys::{Function, Object, Promise, Reflect};
 use leptos::prelude::GetUntracked;
 use plm_core::time::Duration;

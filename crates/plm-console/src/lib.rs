@@ -19,13 +19,17 @@
 #[global_allocator]
 static ALLOCATOR: talc::wasm::WasmDynamicTalc = talc::wasm::new_wasm_dynamic_allocator();
 
+pub mod clock;
 pub mod fleet;
+pub mod line_events;
 pub mod mibform;
 pub mod network;
+pub mod numbers;
 pub mod profile;
 pub mod session;
 pub mod storage;
 pub mod street;
+pub mod tab;
 pub mod traffic;
 pub mod transport;
 

@@ -124,7 +124,7 @@ fn keep<T>(list: &mut Vec<T>, max: usize, item: T) {
 
 /// S/N in words: `S0 62.0 / N0 30.0, S1 61.5 / N1 30.0 dBµV`.
 pub fn sn_text(sn: &SignalNoise) -> String {
-    let d = |v: u32| crate::views::fixed(sn_dbuv(v), 1);
+    let d = |v: u32| crate::numbers::fixed(sn_dbuv(v), 1);
     format!(
         "S0 {} / N0 {}, S1 {} / N1 {} dBµV",
         d(sn.s0),

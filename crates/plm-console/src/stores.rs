@@ -2,6 +2,7 @@
 //! views by context as one [`Console`], and the one place that applies a
 //! session's [`Note`]s to them.
 
+use crate::clock::page_now_us;
 use crate::profile::Profile;
 use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
 use crate::storage::load;
@@ -234,13 +235,6 @@ pub struct Console {
     pub street: StreetStore,
     /// What the console is connected to.
     pub profile: RwSignal<Profile>,
-}
-
-/// The page's clock in µs.
-pub fn page_now_us() -> f64 {
-    web_sys::window()
-        .and_then(|w| w.performance())
-        .map_or(0.0, |p| p.now() * 1_000.0)
 }
 
 /// The console of the page; call once, in the root component.
@@ -717,7 +711,7 @@ impl Console {
         if !events.is_empty() {
             self.sim.line_events.update(|l| {
                 for e in events {
-                    l.push(crate::views::simulator::describe_line_event(&e));
+                    l.push(crate::line_events::describe(&e));
                     if l.len() > LINE_EVENTS {
                         l.remove(0);
                     }

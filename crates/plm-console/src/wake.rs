@@ -22,7 +22,7 @@
 
 #[cfg(target_arch = "wasm32")]
 mod page {
-    use crate::stores::page_now_us;
+    use crate::clock::page_now_us;
     use gloo_timers::callback::Timeout;
     use std::cell::RefCell;
     use std::rc::Rc;

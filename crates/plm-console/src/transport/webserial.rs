@@ -23,7 +23,7 @@
 //! opened again once it is back.
 
 use super::{LinkState, Transport};
-use crate::stores::page_now_us;
+use crate::clock::page_now_us;
 use js_sys::{Reflect, Uint8Array};
 use plm_core::time::Instant;
 use std::cell::RefCell;

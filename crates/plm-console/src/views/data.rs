@@ -6,7 +6,7 @@
 use super::snr_plot::{self, Point};
 use super::widgets::{set_checked, set_value, signal, text_input, text_table};
 use super::{millis, seconds, spaced};
-use crate::app::Tab;
+use crate::tab::Tab;
 use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
 use crate::traffic::Entry;

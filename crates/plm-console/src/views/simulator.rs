@@ -2,52 +2,12 @@
 //! Topology (this modem alone or with echoing peers), line conditions,
 //! UART byte faults, modem reset and unplug, and what happens on the line.
 
-use super::seconds;
 use super::widgets::{button, escape, on_click, on_event, signal};
 use crate::stores::use_console;
 use leptos::prelude::*;
-use plm_core::st7580::fields::MODULATIONS;
 use plm_core::st7580::Temperature;
 use plm_core::time::MS;
-use plm_sim::{ByteFaults, Dir, Fault, LineConfig, LineEvent};
-
-/// A line event in words.
-pub fn describe_line_event(e: &LineEvent) -> String {
-    match e {
-        LineEvent::Sent {
-            at,
-            from,
-            modulation,
-            frequency,
-            bytes,
-            airtime,
-        } => format!(
-            "{}  node {from} sends {bytes} bytes, {} at {frequency} Hz, {} on the line",
-            seconds(*at),
-            MODULATIONS.get(modulation.bits() as usize).unwrap_or(&"?"),
-            super::millis(*airtime)
-        ),
-        LineEvent::Heard {
-            at,
-            from,
-            to,
-            snr_db,
-            corrupted,
-        } => format!(
-            "{}  node {to} hears node {from}, SNR {} dB{}",
-            seconds(*at),
-            super::fixed(*snr_db, 1),
-            if *corrupted {
-                ", with a corrupted byte"
-            } else {
-                ""
-            }
-        ),
-        LineEvent::Missed { at, from, to, why } => {
-            format!("{}  node {to} misses node {from}: {why}", seconds(*at))
-        }
-    }
-}
+use plm_sim::{ByteFaults, Dir, Fault, LineConfig};
 
 /// The view.
 #[component]

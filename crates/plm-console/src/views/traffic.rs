@@ -4,8 +4,8 @@
 use super::files;
 use super::widgets::{button, closest, escape, on_click, on_event, option_html, signal};
 use super::{seconds, spaced};
-use crate::app::Tab;
 use crate::stores::use_console;
+use crate::tab::Tab;
 use crate::traffic::{Entry, Filter, CAPACITY, ROW_PX};
 use leptos::prelude::*;
 use std::sync::Arc;

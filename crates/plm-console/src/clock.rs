@@ -1,0 +1,9 @@
+//! The page's clock: what the sessions, the wake and the WebSerial
+//! transport stamp and pace by.
+
+/// The page's clock in µs (`performance.now()`; 0 where there is none).
+pub fn page_now_us() -> f64 {
+    web_sys::window()
+        .and_then(|w| w.performance())
+        .map_or(0.0, |p| p.now() * 1_000.0)
+}
