@@ -1,6 +1,8 @@
 //! The fleet table: one row per lamp as the Street view shows, sorts,
 //! filters and exports it (CSV and JSON). Pure, so its rules are tested
-//! natively.
+//! natively. [`picture`]: the same fleet as the street picture.
+
+pub mod picture;
 
 use crate::street::Lamp;
 use plm_core::app::energy::Meter;
@@ -27,6 +29,83 @@ pub const COLUMNS: &[(&str, &str)] = &[
     ("last_seen", "Last seen s"),
 ];
 
+/// A lamp's state at a glance, decided once for the table's colours and
+/// the street picture's marks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Look {
+    /// Lit (RUN), at full power as far as this console set it.
+    Running,
+    /// Lit, with a dimming below 100 % last set from this console (the
+    /// board has no dimming read, seed 004 Appendix A).
+    Dimmed,
+    /// Igniting, warming up, waiting to restrike, or a state the seed
+    /// does not list.
+    Between,
+    /// Off (IDLE).
+    Off,
+    /// FAILURE.
+    Failed,
+    /// It stopped answering.
+    Unreachable,
+    /// Not read yet.
+    NotRead,
+}
+
+impl Look {
+    /// Every look, in the legend's order.
+    pub const ALL: [Look; 7] = [
+        Look::Running,
+        Look::Dimmed,
+        Look::Between,
+        Look::Off,
+        Look::Failed,
+        Look::Unreachable,
+        Look::NotRead,
+    ];
+
+    /// The look of `lamp`.
+    pub fn of(lamp: &Lamp) -> Look {
+        match (&lamp.unreachable, lamp.state()) {
+            (Some(_), _) => Look::Unreachable,
+            (None, None) => Look::NotRead,
+            (None, Some(LampState::Run)) if lamp.dimming.is_some_and(|d| d < 100) => Look::Dimmed,
+            (None, Some(LampState::Run)) => Look::Running,
+            (None, Some(LampState::Failure)) => Look::Failed,
+            (None, Some(LampState::Idle)) => Look::Off,
+            (None, Some(_)) => Look::Between,
+        }
+    }
+
+    /// Whether it needs a technician's eye.
+    pub fn in_trouble(self) -> bool {
+        matches!(self, Look::Failed | Look::Unreachable)
+    }
+
+    /// Its name in words.
+    pub fn name(self) -> &'static str {
+        match self {
+            Look::Running => "running",
+            Look::Dimmed => "dimmed",
+            Look::Between => "starting or waiting",
+            Look::Off => "off",
+            Look::Failed => "failed",
+            Look::Unreachable => "not answering",
+            Look::NotRead => "not read yet",
+        }
+    }
+
+    /// Its class in the table's colours (style.css).
+    pub fn class(self) -> &'static str {
+        match self {
+            Look::Running | Look::Dimmed => "lamp-run",
+            Look::Failed | Look::Unreachable => "lamp-bad",
+            Look::Off => "lamp-off",
+            Look::Between => "lamp-busy",
+            Look::NotRead => "",
+        }
+    }
+}
+
 /// One lamp as a row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
@@ -36,6 +115,8 @@ pub struct Row {
     pub firmware: String,
     /// `RUN`, `FAILURE`, `UNREACHABLE`, or empty.
     pub state: String,
+    /// Its state at a glance.
+    pub look: Look,
     /// Whether it needs a technician's eye.
     pub trouble: bool,
     /// Numbers by column key, `None` when unknown.
@@ -47,6 +128,7 @@ impl Row {
     pub fn of(lamp: &Lamp, now: Instant) -> Row {
         let b = lamp.ballast;
         let watched = lamp.energy.watched() > 0;
+        let look = Look::of(lamp);
         let state = match (&lamp.unreachable, lamp.state()) {
             (Some(_), _) => "UNREACHABLE".to_string(),
             (None, Some(s)) => s.name().to_string(),
@@ -58,7 +140,8 @@ impl Row {
                 .discovered
                 .map(|d| d.firmware.to_string())
                 .unwrap_or_default(),
-            trouble: lamp.in_trouble(),
+            look,
+            trouble: look.in_trouble(),
             state,
             numbers: vec![
                 ("dimming", lamp.dimming.map(i64::from)),
@@ -195,17 +278,6 @@ pub fn street_energy<'a>(lamps: impl Iterator<Item = &'a Lamp>) -> String {
         tenths / 10,
         tenths % 10
     )
-}
-
-/// How a lamp state reads in the table's colours.
-pub fn state_class(state: &str) -> &'static str {
-    match state {
-        "RUN" => "lamp-run",
-        "FAILURE" | "UNREACHABLE" => "lamp-bad",
-        s if s == LampState::Idle.name() => "lamp-off",
-        "" => "",
-        _ => "lamp-busy",
-    }
 }
 
 #[cfg(test)]

@@ -81,7 +81,7 @@ impl Lamp {
 
     /// Whether it needs a technician's eye: failed or unreachable.
     pub fn in_trouble(&self) -> bool {
-        self.unreachable.is_some() || self.state() == Some(LampState::Failure)
+        crate::fleet::Look::of(self).in_trouble()
     }
 }
 

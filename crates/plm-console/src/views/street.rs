@@ -347,7 +347,7 @@ fn row_html(row: Option<&Row>, picked: bool) -> String {
     );
     for (key, _) in COLUMNS {
         let class = match *key {
-            "state" => row.map_or("", |r| fleet::state_class(&r.state)),
+            "state" => row.map_or("", |r| r.look.class()),
             "address" | "firmware" => "hex",
             _ => "num",
         };
