@@ -20,8 +20,20 @@
 //!   [`STRIKE_POWER_FRACTION`] of its run value to the run value.
 //! - **RUN** (06h): power follows dimming,
 //!   `P = rated × (MIN_POWER_FRACTION + (1 − MIN_POWER_FRACTION) × dimming / 100)`; lamp voltage
-//!   [`RUN_LAMP_VOLTAGE`] whatever the dimming. Dimming 0 puts the lamp
+//!   [`BallastConfig::lamp_voltage`] ([`RUN_LAMP_VOLTAGE`] by default)
+//!   whatever the dimming. Dimming 0 puts the lamp
 //!   out: **IDLE** (00h). A later dimming above 0 ignites it again.
+//! - **Age** ([`BallastConfig::ages`]): a high-pressure sodium lamp's arc
+//!   voltage rises as it burns, [`AGE_VOLTAGE_RISE`] per 1 000 lifetime
+//!   hours, and the ballast, regulating for the rated lamp, gets a little
+//!   less power into it, [`AGE_POWER_LOSS`] per 1 000 hours; both from
+//!   the lifetime hours the lamp started with (a night adds a few
+//!   hundredths of a volt).
+//! - **End of life** ([`BallastConfig::end_of_life`]): a worn lamp's arc
+//!   voltage climbs while it burns until the ballast cannot hold it
+//!   ([`MAX_LAMP_VOLTAGE`], reached at the time given); the arc goes out
+//!   and the lamp is broken as by [`HidBallast::fail`] (last failure:
+//!   status 06h, lamp voltage [`MAX_LAMP_VOLTAGE`]).
 //! - **WAIT** (07h): a lamp that went out less than [`COOL_DOWN`] ago is
 //!   too hot to restrike; the ballast waits until it has cooled, then
 //!   ignites by itself.
@@ -31,11 +43,21 @@
 //! - Bus voltage [`PFC_BUS_VOLTAGE`] from the PFC while the ballast drives
 //!   the lamp (STARTUP, WARMUP, RUN, WAIT); in IDLE and FAILURE the PFC is
 //!   off and the bus sits at the rectified mains peak (supply × √2); 0
-//!   without mains. Supply voltage [`SUPPLY_VOLTAGE`] ± [`SUPPLY_NOISE`],
-//!   a deterministic function of the ballast's seed and the second.
+//!   without mains. The PFC's set point is [`BallastConfig::bus_voltage`].
+//! - Supply voltage: [`BallastConfig::supply_voltage`] (the mains at this
+//!   pole), plus the street's slow drift when
+//!   [`BallastConfig::supply_drift`] is set (a value in ±
+//!   [`SUPPLY_DRIFT`] every [`SUPPLY_DRIFT_PERIOD`], linear in between,
+//!   the same for every lamp of the street: one transformer), plus
+//!   ± [`SUPPLY_NOISE`] changing every second (this ballast's own); all
+//!   deterministic functions of the seeds and the time.
 //! - Board temperature: a first-order lag (time constant
-//!   [`THERMAL_TIME_CONSTANT`]) toward [`AMBIENT_C`] + [`HEATING_C_PER_W`]
-//!   × lamp power, solved in closed form segment by segment.
+//!   [`THERMAL_TIME_CONSTANT`]) toward the ambient + [`HEATING_C_PER_W`]
+//!   × lamp power, solved in closed form segment by segment. The ambient
+//!   is [`AMBIENT_C`], or with [`BallastConfig::night`] the
+//!   [`NIGHT_AMBIENT`] curve of the time of day (virtual time 0 is
+//!   midnight, as the boards' clocks): piecewise linear, so the segments
+//!   also end at its knots and the solution stays exact.
 //! - Lamp lifetime hours grow while the arc burns (WARMUP and RUN), in
 //!   virtual time, the fraction of an hour carried.
 //!
@@ -82,11 +104,12 @@
 //!
 //! Nothing happens while nobody asks: the state is kept as the phase and
 //! the time it began, and every call first advances the model to `now` in
-//! closed form through at most a few phase boundaries. No events, no ticks.
+//! closed form through at most a few phase boundaries (and, with the night
+//! curve, one segment per knot passed). No events, no ticks.
 
 use plm_core::app::error::ErrorCode;
 use plm_core::app::hid::{self, Ballast, LampState, LastFailure};
-use plm_core::time::{Duration, Instant, MS};
+use plm_core::time::{earliest, Duration, Instant, MS};
 
 use crate::rng::Rng;
 
@@ -135,6 +158,34 @@ pub const AMBIENT_C: f64 = 25.0;
 pub const HEATING_C_PER_W: f64 = 0.2;
 /// Model choice: time constant of the board temperature's first-order lag.
 pub const THERMAL_TIME_CONSTANT: Duration = 600 * SECOND;
+/// Model choice: the ambient temperature of a spring night and day,
+/// (hour of day, °C), linear in between and round the clock: coolest just
+/// before dawn (05:00, 9 °C), warmest mid-afternoon (15:00, 19 °C).
+pub const NIGHT_AMBIENT: [(u64, f64); 8] = [
+    (0, 12.0),
+    (2, 10.6),
+    (5, 9.0),
+    (8, 11.0),
+    (12, 16.5),
+    (15, 19.0),
+    (19, 16.0),
+    (22, 13.4),
+];
+/// Model choice: the slow drift of the street's mains, ± V (the load on
+/// the network changes over the night; EN 50160 allows ± 10 %).
+pub const SUPPLY_DRIFT: f64 = 5.0;
+/// Model choice: the drift takes a new value every this period, linear in
+/// between.
+pub const SUPPLY_DRIFT_PERIOD: Duration = 600 * SECOND;
+/// Model choice: an HPS lamp's arc voltage rise per 1 000 lifetime hours,
+/// V (lamp makers give 1-2 V).
+pub const AGE_VOLTAGE_RISE: f64 = 1.2;
+/// Model choice: the fraction of its rated power an HPS lamp loses per
+/// 1 000 lifetime hours on a ballast regulating for the new lamp.
+pub const AGE_POWER_LOSS: f64 = 0.004;
+/// Model choice: the highest lamp voltage the ballast holds the arc at, V;
+/// a worn lamp whose arc needs more goes out (end-of-life cycling).
+pub const MAX_LAMP_VOLTAGE: f64 = 140.0;
 
 /// What a simulated ballast is at the start.
 #[derive(Debug, Clone, PartialEq)]
@@ -156,6 +207,24 @@ pub struct BallastConfig {
     /// The lamp was already burning in RUN before the simulation began
     /// (no ignition, no warm-up, board at its running temperature).
     pub warm_start: bool,
+    /// The new lamp's voltage in RUN, V.
+    pub lamp_voltage: f64,
+    /// The lamp shows its age: voltage up and power down with the
+    /// lifetime hours it started with ([`AGE_VOLTAGE_RISE`],
+    /// [`AGE_POWER_LOSS`]).
+    pub ages: bool,
+    /// The DC bus voltage the PFC regulates, V.
+    pub bus_voltage: u16,
+    /// The mains at this pole, V RMS (before drift and noise).
+    pub supply_voltage: f64,
+    /// The seed of the street's slow mains drift ([`SUPPLY_DRIFT`]),
+    /// shared by its lamps; `None`: no drift.
+    pub supply_drift: Option<u64>,
+    /// The ambient follows [`NIGHT_AMBIENT`] (else [`AMBIENT_C`]).
+    pub night: bool,
+    /// A worn lamp: its voltage climbs to [`MAX_LAMP_VOLTAGE`], reached at
+    /// this time, and it fails then for good (until repaired).
+    pub end_of_life: Option<Instant>,
 }
 
 impl Default for BallastConfig {
@@ -168,6 +237,13 @@ impl Default for BallastConfig {
             power_ons: 0,
             seed: 0,
             warm_start: false,
+            lamp_voltage: RUN_LAMP_VOLTAGE,
+            ages: false,
+            bus_voltage: PFC_BUS_VOLTAGE,
+            supply_voltage: f64::from(SUPPLY_VOLTAGE),
+            supply_drift: None,
+            night: false,
+            end_of_life: None,
         }
     }
 }
@@ -250,6 +326,10 @@ pub struct HidBallast {
     temperature: f64,
     /// Random failures per lit hour.
     failure_rate: f64,
+    /// When the ballast was made (the start of a worn lamp's climb).
+    born: Instant,
+    /// A worn lamp's end, until it comes (or the lamp is replaced).
+    end_of_life: Option<Instant>,
     /// This ballast's own stream of random failure times.
     rng: Rng,
 }
@@ -272,14 +352,17 @@ impl HidBallast {
             temperature: AMBIENT_C,
             failure_rate: config.failure_rate_per_lit_hour,
             rng: Rng::new(config.seed),
+            born: now,
+            end_of_life: config.end_of_life,
             config,
         };
+        b.temperature = b.ambient(now);
         if b.config.warm_start {
             b.phase = Phase::Lit {
                 warm_until: now,
                 fail_at: b.draw_failure(now),
             };
-            b.temperature = AMBIENT_C + HEATING_C_PER_W * b.run_power(b.dimming);
+            b.temperature = b.ambient(now) + HEATING_C_PER_W * b.run_power(b.dimming);
         } else {
             b.ignite(now);
         }
@@ -350,6 +433,11 @@ impl HidBallast {
         }
     }
 
+    /// What the ballast was made as.
+    pub fn config(&self) -> &BallastConfig {
+        &self.config
+    }
+
     /// The dimming set point, 0-100 %.
     pub fn dimming(&self) -> u8 {
         self.dimming
@@ -366,10 +454,7 @@ impl HidBallast {
     /// Without mains the break shows when the mains return.
     pub fn fail(&mut self, now: Instant) {
         let now = self.advance(now);
-        self.broken = true;
-        if !matches!(self.phase, Phase::Off | Phase::Failed) {
-            self.enter_failure(now);
-        }
+        self.break_lamp(now);
     }
 
     /// A technician fits a new, cold lamp: the failure is cleared, lifetime
@@ -378,6 +463,7 @@ impl HidBallast {
     pub fn repair(&mut self, now: Instant) {
         let now = self.advance(now);
         self.broken = false;
+        self.end_of_life = None;
         self.out_at = None;
         self.lit_us = 0;
         self.lifetime_base = 0;
@@ -494,6 +580,13 @@ impl HidBallast {
         }
     }
 
+    fn break_lamp(&mut self, now: Instant) {
+        self.broken = true;
+        if !matches!(self.phase, Phase::Off | Phase::Failed) {
+            self.enter_failure(now);
+        }
+    }
+
     fn enter_failure(&mut self, now: Instant) {
         let supply = self.supply_voltage(now);
         self.last_failure = LastFailure {
@@ -519,8 +612,12 @@ impl HidBallast {
     }
 
     /// The next time the phase changes by itself (or, during warm-up, the
-    /// end of the power ramp), after `self.at`.
+    /// end of the power ramp, or a worn lamp's end), after `self.at`.
     fn next_boundary(&self) -> Option<Instant> {
+        earliest(self.next_phase_boundary(), self.end_of_life)
+    }
+
+    fn next_phase_boundary(&self) -> Option<Instant> {
         match self.phase {
             Phase::Wait { until } => Some(until),
             Phase::Startup { since } => Some(since.saturating_add(3 * IGNITION_STEP)),
@@ -544,6 +641,11 @@ impl HidBallast {
         let now = now.max(self.at);
         while let Some(t) = self.next_boundary().filter(|&t| t <= now) {
             self.integrate(t);
+            if self.end_of_life.is_some_and(|e| e <= t) {
+                self.break_lamp(t);
+                self.end_of_life = None;
+                continue;
+            }
             match self.phase {
                 Phase::Wait { .. } => self.start_ignition(t),
                 Phase::Startup { .. } if self.broken => self.enter_failure(t),
@@ -565,11 +667,19 @@ impl HidBallast {
     }
 
     /// Carries lifetime and temperature from `self.at` to `t` within one
-    /// phase (power linear in time over the span).
+    /// phase (power linear in time over the span), a piece of the ambient
+    /// curve at a time (linear within it).
     fn integrate(&mut self, t: Instant) {
-        if t <= self.at {
-            return;
+        while self.at < t {
+            let to = match self.config.night {
+                true => t.min(next_knot(self.at)),
+                false => t,
+            };
+            self.integrate_piece(to);
         }
+    }
+
+    fn integrate_piece(&mut self, t: Instant) {
         let dt = t - self.at;
         if matches!(self.phase, Phase::Lit { .. }) {
             self.lit_us = self.lit_us.saturating_add(dt);
@@ -577,12 +687,28 @@ impl HidBallast {
         // dT/dt = (u(t) − T)/τ with u linear, u(s) = a + b·s: T(dt) =
         // u(dt) − bτ + (T0 − a + bτ)·e^(−dt/τ).
         let tau = THERMAL_TIME_CONSTANT as f64;
-        let a = AMBIENT_C + HEATING_C_PER_W * self.lamp_power(self.at);
-        let u1 = AMBIENT_C + HEATING_C_PER_W * self.lamp_power(t);
+        let a = self.ambient(self.at) + HEATING_C_PER_W * self.lamp_power(self.at);
+        let u1 = self.ambient(t) + HEATING_C_PER_W * self.lamp_power(t);
         let b = (u1 - a) / dt as f64;
         self.temperature =
             u1 - b * tau + (self.temperature - a + b * tau) * (-(dt as f64) / tau).exp();
         self.at = t;
+    }
+
+    /// The ambient temperature at `now`, °C.
+    fn ambient(&self, now: Instant) -> f64 {
+        if !self.config.night {
+            return AMBIENT_C;
+        }
+        let s = now % DAY;
+        let i = knot_before(s);
+        let (h0, c0) = NIGHT_AMBIENT[i];
+        let (h1, c1) = NIGHT_AMBIENT
+            .get(i + 1)
+            .copied()
+            .unwrap_or((24, NIGHT_AMBIENT[0].1));
+        let (t0, t1) = (h0 * HOUR, h1 * HOUR);
+        c0 + (c1 - c0) * (s - t0) as f64 / (t1 - t0) as f64
     }
 
     // --- readings -------------------------------------------------------
@@ -612,9 +738,33 @@ impl HidBallast {
         }
     }
 
+    /// The lamp's age at the start (or 0 after a repair), thousands of
+    /// hours, when it shows.
+    fn age_kh(&self) -> f64 {
+        match self.config.ages {
+            true => f64::from(self.lifetime_base) / 1_000.0,
+            false => 0.0,
+        }
+    }
+
     fn run_power(&self, dimming: u8) -> f64 {
         let d = f64::from(dimming.min(hid::DIMMING_MAX)) / 100.0;
-        f64::from(self.config.rated_power_w) * (MIN_POWER_FRACTION + (1.0 - MIN_POWER_FRACTION) * d)
+        let rated = f64::from(self.config.rated_power_w) * (1.0 - AGE_POWER_LOSS * self.age_kh());
+        rated.max(0.0) * (MIN_POWER_FRACTION + (1.0 - MIN_POWER_FRACTION) * d)
+    }
+
+    /// Lamp voltage at the end of the warm-up: the lamp's, aged, and for a
+    /// worn lamp climbing to [`MAX_LAMP_VOLTAGE`] at its end.
+    fn run_voltage(&self, now: Instant) -> f64 {
+        let v = self.config.lamp_voltage + AGE_VOLTAGE_RISE * self.age_kh();
+        match self.end_of_life {
+            Some(end) if end > self.born => {
+                let x = (now.saturating_sub(self.born) as f64 / (end - self.born) as f64).min(1.0);
+                v + (MAX_LAMP_VOLTAGE - v).max(0.0) * x
+            }
+            Some(_) => MAX_LAMP_VOLTAGE.max(v),
+            None => v,
+        }
     }
 
     fn lamp_power(&self, now: Instant) -> f64 {
@@ -632,7 +782,7 @@ impl HidBallast {
         match self.phase {
             Phase::Lit { .. } => {
                 let x = self.warm_progress(now);
-                STRIKE_LAMP_VOLTAGE + (RUN_LAMP_VOLTAGE - STRIKE_LAMP_VOLTAGE) * x
+                STRIKE_LAMP_VOLTAGE + (self.run_voltage(now) - STRIKE_LAMP_VOLTAGE) * x
             }
             _ => 0.0,
         }
@@ -645,9 +795,21 @@ impl HidBallast {
         // A hash of (seed, second): the same reading within a second, and
         // no draw from any stream, so asking does not change the future.
         let slot = now / SUPPLY_NOISE_PERIOD;
-        let r = Rng::new(self.config.seed ^ slot.wrapping_mul(0xA24B_AED4_963E_E407)).next_u64();
+        let r = hash(self.config.seed, slot);
         let span = 2 * u64::from(SUPPLY_NOISE) + 1;
-        SUPPLY_VOLTAGE - SUPPLY_NOISE + (r % span) as u16
+        let noise = (r % span) as f64 - f64::from(SUPPLY_NOISE);
+        round_u16(self.config.supply_voltage + self.supply_drift(now) + noise)
+    }
+
+    /// The street's slow mains drift at `now`, V (0 without).
+    fn supply_drift(&self, now: Instant) -> f64 {
+        let Some(seed) = self.config.supply_drift else {
+            return 0.0;
+        };
+        let k = now / SUPPLY_DRIFT_PERIOD;
+        let knot = |k: u64| (hash(seed, k) >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let x = (now % SUPPLY_DRIFT_PERIOD) as f64 / SUPPLY_DRIFT_PERIOD as f64;
+        SUPPLY_DRIFT * (knot(k) + (knot(k + 1) - knot(k)) * x)
     }
 
     fn bus_voltage(&self, supply: u16) -> u16 {
@@ -655,7 +817,7 @@ impl HidBallast {
             Phase::Off => 0,
             // PFC off: the bus capacitor holds the rectified mains peak.
             Phase::Idle | Phase::Failed => round_u16(f64::from(supply) * core::f64::consts::SQRT_2),
-            _ => PFC_BUS_VOLTAGE,
+            _ => self.config.bus_voltage,
         }
     }
 
@@ -663,6 +825,32 @@ impl HidBallast {
         let hours = self.lit_us / HOUR;
         u16::try_from(u64::from(self.lifetime_base) + hours).unwrap_or(u16::MAX)
     }
+}
+
+/// Microseconds in a day.
+const DAY: Duration = 24 * HOUR;
+
+/// The index of the [`NIGHT_AMBIENT`] knot at or before `s` µs of the
+/// day.
+fn knot_before(s: Duration) -> usize {
+    NIGHT_AMBIENT
+        .iter()
+        .rposition(|&(h, _)| h * HOUR <= s)
+        .unwrap_or(0)
+}
+
+/// The first knot of the ambient curve after `now`.
+fn next_knot(now: Instant) -> Instant {
+    let s = now % DAY;
+    let i = knot_before(s);
+    let next = NIGHT_AMBIENT.get(i + 1).map_or(DAY, |&(h, _)| h * HOUR);
+    (now - s).saturating_add(next)
+}
+
+/// A hash of (seed, slot): a reading that is the same within its slot and
+/// draws from no stream, so asking does not change the future.
+fn hash(seed: u64, slot: u64) -> u64 {
+    Rng::new(seed ^ slot.wrapping_mul(0xA24B_AED4_963E_E407)).next_u64()
 }
 
 fn round_u16(v: f64) -> u16 {

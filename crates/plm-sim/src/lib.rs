@@ -17,7 +17,8 @@
 //! - [`line`]: the power line.
 //! - [`uart`]: a UART direction with fault injection.
 //! - [`echo`]: the echoing host of simulated peers.
-//! - [`ballast`]: the HID ballast of a board and its lamp model.
+//! - [`ballast`]: the HID ballast of a board and its lamp model;
+//!   [`profile`]: how a street's lamps differ.
 //! - [`board`]: the street-light controller board (STEVAL-IHP007V1) whose
 //!   firmware drives its modem, and a concentrator board's USART;
 //!   [`breach`]: one that breaks a rule of the board protocol, on demand.
@@ -37,6 +38,7 @@ pub mod flash;
 pub mod line;
 pub mod modem;
 pub mod ports;
+pub mod profile;
 pub mod rfu;
 pub mod rng;
 pub mod sim;
@@ -47,6 +49,7 @@ pub mod uart;
 pub use drive::{HostDriver, Outcome};
 pub use line::LineConfig;
 pub use ports::Ports;
+pub use profile::StreetProfile;
 pub use sim::{Attach, Dir, Fault, LineEvent, Peers, Sim, SimConfig};
 pub use street::StreetDriver;
 pub use uart::{ByteFaults, BAUD_RATES};

@@ -54,6 +54,10 @@ pub struct LineConfig {
     /// `n` is on phase `n % 3`): the signal crosses at the transformer
     /// or through coupling capacitors (STEVAL UM 2, Figure 3), dB.
     pub phase_coupling_db: f64,
+    /// Extra loss of some nodes' connection to the line (a long service
+    /// cable, a poor joint): (node, dB), added to every link to or from
+    /// the node.
+    pub node_loss_db: Vec<(usize, f64)>,
 }
 
 impl Default for LineConfig {
@@ -66,6 +70,7 @@ impl Default for LineConfig {
             capture_db: Some(CAPTURE_DB),
             corruption: 0.0,
             phase_coupling_db: 0.0,
+            node_loss_db: Vec::new(),
         }
     }
 }
@@ -79,7 +84,13 @@ impl LineConfig {
         } else {
             0.0
         };
-        self.attenuation_db + hops * self.attenuation_per_hop_db + coupling
+        let own: f64 = self
+            .node_loss_db
+            .iter()
+            .filter(|&&(n, _)| n == a || n == b)
+            .map(|&(_, db)| db)
+            .sum();
+        self.attenuation_db + hops * self.attenuation_per_hop_db + coupling + own
     }
 
     /// A street of `lamps` boards behind a concentrator (model): lamps on

@@ -18,6 +18,7 @@ use crate::breach::Breach;
 use crate::echo::EchoHost;
 use crate::line::{self, LineConfig, Transmission};
 use crate::modem::{Reception, St7580};
+use crate::profile::StreetProfile;
 use crate::rng::Rng;
 use crate::st7570::line::power_sum;
 use crate::uart::{ByteFaults, OneShot, Wire};
@@ -47,8 +48,11 @@ pub struct SimConfig {
     /// Nodes whose host is outside, 0 up to this (at least 1; more than 1
     /// only with [`Attach::Modem`] and echoing peers).
     pub served: usize,
-    /// The lamps of a street's boards.
+    /// The lamps of a street's boards, before [`SimConfig::profile`]
+    /// shapes each.
     pub ballast: BallastConfig,
+    /// How a street's lamps differ, from [`SimConfig::seed`].
+    pub profile: StreetProfile,
     /// The modulation the street's boards (and a concentrator board)
     /// send with (their firmware's TxParams; B-PSK by default).
     pub modulation: Modulation,
@@ -69,6 +73,7 @@ impl Default for SimConfig {
             peers: Peers::Echo,
             served: 1,
             ballast: BallastConfig::default(),
+            profile: StreetProfile::Uniform,
             modulation: Modulation::BPsk,
             breach: None,
         }
@@ -356,6 +361,13 @@ impl Sim {
     /// from when its host is there to hear them).
     pub fn new(config: SimConfig) -> Sim {
         let mut rng = Rng::new(config.seed);
+        // The far lamp's poor connection, on a realistic street.
+        let lamps = config.nodes.max(1) - 1;
+        let mut line = config.line.clone();
+        if config.peers == Peers::Street {
+            line.node_loss_db
+                .extend(config.profile.weak_lamp(lamps, &config.line));
+        }
         let nodes: Vec<Node> = (0..config.nodes.max(1))
             .map(|i| {
                 let board = |ballast, clock_offset| {
@@ -393,6 +405,7 @@ impl Sim {
                             ballast.lifetime_hours = rng.below(8_000) as u16;
                             ballast.power_ons = ballast.lifetime_hours / 11 + 1;
                         }
+                        config.profile.shape(config.seed, i, lamps, &mut ballast);
                         Host::Board(Box::new(
                             board(Some(ballast), offset).with_breach(config.breach),
                         ))
@@ -417,7 +430,7 @@ impl Sim {
             now: 0,
             seq: 0,
             rng,
-            line: config.line,
+            line,
             nodes,
             queue: BinaryHeap::new(),
             host_rx: vec![VecDeque::new(); served],
