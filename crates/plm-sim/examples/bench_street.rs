@@ -350,6 +350,10 @@ fn update(lamps: usize, size: usize) {
 }
 
 fn main() {
+    if let Ok(n) = std::env::var("SWEEP") {
+        sweep(n.parse().expect("SWEEP: a number of lamps"), 5);
+        return;
+    }
     if let Ok(n) = std::env::var("LAMPS") {
         discover_and_read(n.parse().expect("LAMPS: a number"));
         return;

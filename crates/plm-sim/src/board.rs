@@ -247,10 +247,19 @@ impl Board {
         self.outputs
     }
 
-    /// Bytes from its modem.
-    pub fn handle_rx(&mut self, now: Instant, bytes: &[u8], rng: &mut Rng) {
-        self.engine.handle_rx(now, bytes);
-        self.pump(now, rng);
+    /// Bytes from its modem, each with its arrival time, oldest first.
+    /// The firmware acts once on what they completed, at the last one's
+    /// time: a run of one write of the modem completes at most its last
+    /// byte's element (UM0932 3.2: one frame, ACK or status message).
+    pub fn handle_rx(&mut self, bytes: impl IntoIterator<Item = (Instant, u8)>, rng: &mut Rng) {
+        let mut last = None;
+        for (at, b) in bytes {
+            self.engine.handle_rx(at, &[b]);
+            last = Some(at);
+        }
+        if let Some(at) = last {
+            self.pump(at, rng);
+        }
     }
 
     /// Bytes from the outside host on the USART (a concentrator).

@@ -42,10 +42,17 @@ impl EchoHost {
         self.engine.submit(now, cmd.to_frame());
     }
 
-    /// Bytes from the modem.
-    pub fn handle_rx(&mut self, now: Instant, bytes: &[u8]) {
-        self.engine.handle_rx(now, bytes);
-        self.pump(now);
+    /// Bytes from the modem, each with its arrival time, oldest first
+    /// (as [`crate::board::Board::handle_rx`]).
+    pub fn handle_rx(&mut self, bytes: impl IntoIterator<Item = (Instant, u8)>) {
+        let mut last = None;
+        for (at, b) in bytes {
+            self.engine.handle_rx(at, &[b]);
+            last = Some(at);
+        }
+        if let Some(at) = last {
+            self.pump(at);
+        }
     }
 
     /// When [`EchoHost::handle_timeout`] is due.

@@ -94,6 +94,12 @@ pub struct St7580 {
     baud: u32,
     engine: DeviceEngine,
     mib: Vec<Vec<u8>>,
+    /// MIB 00h and 01h decoded, kept in step with `mib` by
+    /// [`St7580::store`] and [`St7580::reset`]: every frame on the line
+    /// asks for them.
+    config: (ModemConfig, PhyConfig),
+    /// The status last handed to the link engine.
+    status_sent: Option<Status>,
     /// MIB 00h, 01h, 02h written since power-on (Table 19 bits 3-5).
     written: [bool; 3],
     power: Power,
@@ -114,11 +120,14 @@ impl St7580 {
     /// Modem of node `node`, powering on at `now` (UART at `baud`); `seed`
     /// fixes the IVs it picks.
     pub fn new(node: usize, baud: u32, now: Instant, seed: u64) -> Self {
+        let mib = factory_mib();
         let mut m = St7580 {
             node,
             baud,
             engine: DeviceEngine::new(Dialect::St7580, baud),
-            mib: Vec::new(),
+            config: decode_config(&mib),
+            mib,
+            status_sent: None,
             written: [false; 3],
             power: Power::On,
             treq: false,
@@ -158,12 +167,12 @@ impl St7580 {
 
     /// MIB 00h.
     pub fn modem_config(&self) -> ModemConfig {
-        ModemConfig::decode(&self.mib[index::MODEM_CONFIG as usize])
+        self.config.0
     }
 
     /// MIB 01h.
     pub fn phy_config(&self) -> PhyConfig {
-        PhyConfig::decode(&self.mib[index::PHY_CONFIG as usize])
+        self.config.1
     }
 
     /// Whether a power line frame is being transmitted.
@@ -201,8 +210,7 @@ impl St7580 {
     /// is lost; the BIO_ResetIndication follows after [`BOOT_TIME`].
     pub fn reset(&mut self, now: Instant, cause: ResetCause) {
         let keep = cause != ResetCause::PowerOn;
-        let old = std::mem::take(&mut self.mib);
-        self.mib = mib::OBJECTS.iter().map(|o| o.default.to_vec()).collect();
+        let old = std::mem::replace(&mut self.mib, factory_mib());
         if keep {
             for (i, value) in old.into_iter().take(3).enumerate() {
                 if self.written[i] {
@@ -212,7 +220,9 @@ impl St7580 {
         } else {
             self.written = [false; 3];
         }
+        self.config = decode_config(&self.mib);
         self.engine = DeviceEngine::new(Dialect::St7580, self.baud);
+        self.status_sent = None;
         self.tx = None;
         self.reset_pending = false;
         self.overcurrent = false;
@@ -453,8 +463,11 @@ impl St7580 {
     }
 
     fn refresh_status(&mut self) {
-        let s = self.status().to_message();
-        self.engine.set_status(s);
+        let s = self.status();
+        if self.status_sent != Some(s) {
+            self.status_sent = Some(s);
+            self.engine.set_status(s.to_message());
+        }
     }
 
     /// Executes a request the link engine accepted (UM0932 3.3, Table 10).
@@ -633,6 +646,9 @@ impl St7580 {
             v.clear();
             v.extend_from_slice(data);
         }
+        if index == index::MODEM_CONFIG || index == index::PHY_CONFIG {
+            self.config = decode_config(&self.mib);
+        }
     }
 
     fn counter(&self, index: u8, at: usize) -> u16 {
@@ -649,6 +665,19 @@ impl St7580 {
         let v = self.counter(index, at).wrapping_add(1);
         self.set_counter(index, at, v);
     }
+}
+
+/// Every MIB object at its factory value (Table 52).
+fn factory_mib() -> Vec<Vec<u8>> {
+    mib::OBJECTS.iter().map(|o| o.default.to_vec()).collect()
+}
+
+/// MIB 00h and 01h of `mib`, decoded.
+fn decode_config(mib: &[Vec<u8>]) -> (ModemConfig, PhyConfig) {
+    (
+        ModemConfig::decode(&mib[index::MODEM_CONFIG as usize]),
+        PhyConfig::decode(&mib[index::PHY_CONFIG as usize]),
+    )
 }
 
 /// A frame as one modem received it.

@@ -28,6 +28,7 @@ use plm_core::st7580::{Channel, Command, Modulation, ResetCause, Temperature};
 use plm_core::time::{earliest, Duration, Instant};
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
+use std::sync::Arc;
 
 /// How a simulation starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -241,9 +242,15 @@ enum Ev {
         node: usize,
         byte: u8,
     },
+    /// A byte for an outside host.
     ToHost {
         node: usize,
         byte: u8,
+    },
+    /// The last byte of a write of `node`'s modem has reached its inside
+    /// host: the host takes what its inbox holds by now.
+    HostBytes {
+        node: usize,
     },
     Treq {
         node: usize,
@@ -258,9 +265,11 @@ enum Ev {
         byte: u8,
     },
     TxStart(Box<Transmission>),
+    /// Frame `id` ends at the modems that were receiving it, in node
+    /// order.
     RxEnd {
-        node: usize,
         id: u64,
+        nodes: Vec<usize>,
     },
 }
 
@@ -292,7 +301,7 @@ impl Ord for Scheduled {
 #[derive(Debug, Clone)]
 struct ActiveRx {
     id: u64,
-    tx: Transmission,
+    tx: Arc<Transmission>,
     channel: Channel,
     level: f64,
     /// The other frames that overlapped it on its channel: their powers
@@ -312,6 +321,9 @@ struct Node {
     /// Modem to host.
     up: Wire,
     host: Host,
+    /// What the modem wrote to an inside host ([`Host::Echo`],
+    /// [`Host::Board`]), with each byte's arrival time, not yet taken.
+    inbox: VecDeque<(Instant, u8)>,
     rx: Vec<ActiveRx>,
     /// Cut off the line (the board's supply off, its cable cut): it
     /// neither hears nor is heard.
@@ -416,6 +428,7 @@ impl Sim {
                     down: Wire::new(config.baud),
                     up: Wire::new(config.baud),
                     host,
+                    inbox: VecDeque::new(),
                     rx: Vec::new(),
                     cut: false,
                 }
@@ -511,6 +524,9 @@ impl Sim {
         f: impl FnOnce(&mut Board, Instant) -> R,
     ) -> Option<R> {
         let now = self.now;
+        if node < self.nodes.len() {
+            self.take_inbox(node);
+        }
         let r = match &mut self.nodes.get_mut(node)?.host {
             Host::Board(b) => Some(f(b, now)),
             _ => None,
@@ -576,6 +592,9 @@ impl Sim {
     /// e.g. a data request: peers can talk first, not only echo.
     pub fn peer_request(&mut self, node: usize, cmd: &Command) {
         let now = self.now;
+        if node < self.nodes.len() {
+            self.take_inbox(node);
+        }
         if let Some(Host::Echo(app)) = self.nodes.get_mut(node).map(|n| &mut n.host) {
             app.submit(now, cmd);
         }
@@ -879,11 +898,15 @@ impl Sim {
         }
         self.drop_stale_timers();
         for i in due {
-            let Sim { nodes, rng, .. } = self;
-            let n = &mut nodes[i];
+            let n = &mut self.nodes[i];
             if n.modem.poll_timeout().is_some_and(|d| d <= now) {
                 n.modem.handle_timeout(now);
             }
+            if !n.inbox.is_empty() {
+                self.take_inbox(i);
+            }
+            let Sim { nodes, rng, .. } = self;
+            let n = &mut nodes[i];
             if n.host.poll_timeout().is_some_and(|d| d <= now) {
                 match &mut n.host {
                     Host::Outside => {}
@@ -896,13 +919,34 @@ impl Sim {
         self.flush();
     }
 
+    /// Hands `node`'s inside host the bytes of its inbox that have
+    /// arrived by now, each at its arrival time: the bytes of a write are
+    /// taken together at its last byte's event, or, when the host has a
+    /// deadline of its own (or is acted on) in the middle of a write,
+    /// those before it first. The host sees each byte when it came, as if
+    /// each were an event, at one event per write (a 500-lamp street's
+    /// boards each hear every frame on the line).
+    fn take_inbox(&mut self, node: usize) {
+        let now = self.now;
+        let Sim { nodes, rng, .. } = self;
+        let n = &mut nodes[node];
+        let come = n.inbox.partition_point(|b| b.0 <= now);
+        let run = n.inbox.drain(..come);
+        match &mut n.host {
+            Host::Echo(app) => app.handle_rx(run),
+            Host::Board(b) => b.handle_rx(run, rng),
+            Host::Outside => {}
+        }
+    }
+
     fn dispatch(&mut self, ev: Ev) {
         let now = self.now;
         match &ev {
-            Ev::ToModem { node, .. } | Ev::ToHost { node, .. } | Ev::Treq { node, .. } => {
-                self.touch(*node)
-            }
-            Ev::RxEnd { node, .. } => self.touch(*node),
+            Ev::ToModem { node, .. }
+            | Ev::ToHost { node, .. }
+            | Ev::HostBytes { node }
+            | Ev::Treq { node, .. } => self.touch(*node),
+            Ev::RxEnd { .. } => {}
             Ev::ToUsart { .. } => self.touch(0),
             Ev::FromUsart { .. } | Ev::TxStart(_) => {}
         }
@@ -912,15 +956,12 @@ impl Sim {
                     self.nodes[node].modem.handle_rx(now, &[byte]);
                 }
             }
-            Ev::ToHost { node, byte } => match &mut self.nodes[node].host {
-                Host::Echo(app) => app.handle_rx(now, &[byte]),
-                Host::Board(b) => b.handle_rx(now, &[byte], &mut self.rng),
-                Host::Outside => {
-                    if self.plugged[node] {
-                        self.host_rx[node].push_back((now, byte));
-                    }
+            Ev::ToHost { node, byte } => {
+                if self.plugged[node] {
+                    self.host_rx[node].push_back((now, byte));
                 }
-            },
+            }
+            Ev::HostBytes { node } => self.take_inbox(node),
             Ev::ToUsart { byte } => {
                 if let (true, Host::Board(b)) = (self.plugged[0], &mut self.nodes[0].host) {
                     b.usart_rx(now, &[byte], &mut self.rng);
@@ -937,7 +978,14 @@ impl Sim {
                 }
             }
             Ev::TxStart(tx) => self.start_transmission(*tx),
-            Ev::RxEnd { node, id } => self.end_reception(node, id),
+            Ev::RxEnd { id, nodes } => {
+                // One after another, as if each had its own event.
+                for node in nodes {
+                    self.touch(node);
+                    self.end_reception(node, id);
+                    self.flush();
+                }
+            }
         }
     }
 
@@ -949,8 +997,13 @@ impl Sim {
             self.is_dirty[i] = false;
             while let Some(bytes) = self.nodes[i].modem.poll_transmit() {
                 let arrivals = self.nodes[i].up.write(now, &bytes, &mut self.rng);
-                for (at, byte) in arrivals {
-                    self.schedule(at, Ev::ToHost { node: i, byte });
+                if matches!(self.nodes[i].host, Host::Outside) {
+                    for (at, byte) in arrivals {
+                        self.schedule(at, Ev::ToHost { node: i, byte });
+                    }
+                } else if let Some(&(last, _)) = arrivals.last() {
+                    self.nodes[i].inbox.extend(arrivals);
+                    self.schedule(last, Ev::HostBytes { node: i });
                 }
             }
             while let Some(tx) = self.nodes[i].modem.poll_line() {
@@ -1030,6 +1083,8 @@ impl Sim {
         if self.nodes[tx.from].cut {
             return;
         }
+        let tx = Arc::new(tx);
+        let mut receivers = Vec::new();
         for to in 0..self.nodes.len() {
             if to == tx.from || self.nodes[to].cut {
                 continue;
@@ -1070,7 +1125,7 @@ impl Sim {
             }
             n.rx.push(ActiveRx {
                 id,
-                tx: tx.clone(),
+                tx: Arc::clone(&tx),
                 channel,
                 level,
                 others,
@@ -1079,7 +1134,16 @@ impl Sim {
             });
             n.modem.set_receiving(true);
             self.touch(to);
-            self.schedule(tx.end, Ev::RxEnd { node: to, id });
+            receivers.push(to);
+        }
+        if !receivers.is_empty() {
+            self.schedule(
+                tx.end,
+                Ev::RxEnd {
+                    id,
+                    nodes: receivers,
+                },
+            );
         }
     }
 
