@@ -139,6 +139,13 @@ struct SimArgs {
     /// are already burning, as a street at work is).
     #[arg(long, conflicts_with = "nodes")]
     cold_lamps: bool,
+    /// Every lamp of the street alike (150 W, new, 25 °C around it,
+    /// nothing failing unless asked). By default the lamps differ as a
+    /// real street's, from the seed: powers, ages, the mains drifting,
+    /// the night's temperature, a worn lamp that fails about 2 minutes
+    /// in, a weak far lamp (plm-sim's street profile).
+    #[arg(long, conflicts_with = "nodes")]
+    uniform_lamps: bool,
     /// Random lamp failures: the rate per lamp per lit hour (0-60; 0, the
     /// default, fails none). A failed lamp stays in FAILURE until a reset
     /// or a power cycle relights it (plm-sim's ballast model).
@@ -269,6 +276,7 @@ fn st7570_world(args: &SimArgs) -> Result<sim_server::World, String> {
         (args.board, "--board"),
         (args.peers.is_some(), "--peers"),
         (args.cold_lamps, "--cold-lamps"),
+        (args.uniform_lamps, "--uniform-lamps"),
         (args.lamp_failures > 0.0, "--lamp-failures"),
         (args.breach.is_some(), "--break"),
     ] {
@@ -335,6 +343,7 @@ fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
             lamps: n.map_or(sim_server::DEFAULT_STREET, usize::from),
             attach: plm_sim::Attach::Board,
             cold: args.cold_lamps,
+            uniform: args.uniform_lamps,
             failures: args.lamp_failures,
             breach: args.breach,
         },
@@ -342,12 +351,19 @@ fn st7580_world(args: &SimArgs) -> Result<sim_server::World, String> {
             lamps: n.into(),
             attach: plm_sim::Attach::Modem,
             cold: args.cold_lamps,
+            uniform: args.uniform_lamps,
             failures: args.lamp_failures,
             breach: args.breach,
         },
-        (false, None) if args.cold_lamps || args.lamp_failures > 0.0 || args.breach.is_some() => {
+        (false, None)
+            if args.cold_lamps
+                || args.uniform_lamps
+                || args.lamp_failures > 0.0
+                || args.breach.is_some() =>
+        {
             return Err(
-                "--cold-lamps, --lamp-failures and --break need a street of lamps: add --street N or --board"
+                "--cold-lamps, --uniform-lamps, --lamp-failures and --break need a street of lamps: \
+                 add --street N or --board"
                     .into(),
             )
         }

@@ -46,7 +46,8 @@ pub mod client;
 pub mod event_loop;
 
 pub use event_loop::{Served, Stopper, RATES};
-use plm_sim::{Attach, LineConfig, Peers, Sim, SimConfig};
+use plm_sim::board::street_address;
+use plm_sim::{Attach, LineConfig, Peers, Sim, SimConfig, StreetProfile};
 use std::net::{SocketAddr, TcpListener, ToSocketAddrs};
 
 /// Lamps on a street unless told otherwise (`--board` alone).
@@ -100,6 +101,9 @@ pub enum World {
         /// (otherwise they burn in RUN from the start,
         /// `BallastConfig::warm_start`).
         cold: bool,
+        /// Every lamp alike (`StreetProfile::Uniform`); otherwise they
+        /// differ as a real street's (`StreetProfile::Realistic`).
+        uniform: bool,
         /// Random lamp failures per lamp per lit hour (0: none;
         /// `BallastConfig::failure_rate_per_lit_hour`).
         failures: f64,
@@ -203,12 +207,17 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
             lamps,
             attach,
             cold,
+            uniform,
             failures,
             breach,
         } => (
             {
                 let street = SimConfig::street(lamps, attach);
                 SimConfig {
+                    profile: match uniform {
+                        true => StreetProfile::Uniform,
+                        false => StreetProfile::Realistic,
+                    },
                     ballast: plm_sim::ballast::BallastConfig {
                         warm_start: !cold,
                         failure_rate_per_lit_hour: failures,
@@ -270,6 +279,14 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         ));
     }
     if let World::Street {
+        lamps,
+        uniform: false,
+        ..
+    } = opts.world
+    {
+        banner.extend(street_banner(opts.seed, lamps));
+    }
+    if let World::Street {
         breach: Some(b), ..
     } = opts.world
     {
@@ -288,6 +305,30 @@ pub fn bind(opts: Options) -> Result<Bound, String> {
         banner,
         served: Served::new(Box::new(sim), listeners, signatures),
     })
+}
+
+/// What the banner says of a realistic street's lamps that stand out.
+fn street_banner(seed: u64, lamps: usize) -> Vec<String> {
+    let profile = StreetProfile::Realistic;
+    let mut said = vec![String::from(
+        "plm sim: the lamps differ as a real street's: powers, ages, the mains drifting, \
+         the night's temperature (--uniform-lamps: all alike)",
+    )];
+    if let Some(n) = profile.worn_lamp(seed, lamps) {
+        said.push(format!(
+            "plm sim: lamp {} (node {n}) is worn out and fails about 2 minutes in",
+            street_address(n)
+        ));
+    }
+    let line = LineConfig::street(lamps);
+    if let Some((n, _)) = profile.weak_lamp(lamps, &line) {
+        said.push(format!(
+            "plm sim: lamp {} (node {n}), the far one, is heard weakly (SNR about {} dB)",
+            street_address(n),
+            plm_sim::profile::WEAK_SNR_DB
+        ));
+    }
+    said
 }
 
 /// What the banner says of a line that is not ideal (nothing for the

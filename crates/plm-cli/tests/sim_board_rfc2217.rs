@@ -548,6 +548,36 @@ fn cold_lamps_need_a_street() {
     assert!(err.contains("--street"), "{err}");
 }
 
+/// The lamps of a street differ as a real street's by default: the
+/// start-up lines name the worn lamp and the weak far one. With
+/// `--uniform-lamps` they are alike and nothing is said of them; without
+/// a street the flag is refused.
+#[test]
+fn the_default_street_names_its_worn_and_weak_lamps() {
+    let args = ["--board", "--street", "5", "--listen", "127.0.0.1:0"];
+    let mut server = Server::start(&args);
+    let lines = server.lines_up_to("powers on");
+    let said = |what: &str| lines.iter().any(|l| l.contains(what));
+    assert!(said("fails about 2 minutes in"), "{lines:?}");
+    assert!(said("(node 5), the far one, is heard weakly"), "{lines:?}");
+    server.interrupt();
+    let mut server = Server::start(&[&args[..], &["--uniform-lamps"]].concat());
+    let lines = server.lines_up_to("powers on");
+    assert!(
+        !lines
+            .iter()
+            .any(|l| l.contains("worn") || l.contains("weakly")),
+        "{lines:?}"
+    );
+    server.interrupt();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_plm"))
+        .args(["sim", "--uniform-lamps", "--listen", "127.0.0.1:0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--street"));
+}
+
 /// `--lamp-failures` needs a street too, and a rate in range.
 #[test]
 fn lamp_failures_need_a_street_and_a_rate() {

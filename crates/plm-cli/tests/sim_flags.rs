@@ -157,6 +157,7 @@ fn street_and_echo_flags_are_refused_with_chip_st7570() {
         &["--board"],
         &["--peers", "factory"],
         &["--cold-lamps"],
+        &["--uniform-lamps"],
         &["--lamp-failures", "1"],
     ] {
         let args = [&["--chip", "st7570"][..], flag].concat();

@@ -49,6 +49,11 @@ pub fn App() -> impl IntoView {
     if let Some(n) = query("speed").and_then(|n| n.parse::<u32>().ok()) {
         console.sim.speed.set(n.clamp(1, 20));
     }
+    // `?street=uniform`: every simulated lamp alike (tests counting exact
+    // values); the demo's lamps differ as a real street's.
+    if query("street").as_deref() == Some("uniform") {
+        console.sim.uniform.set(true);
+    }
     console.connect_simulated();
     crate::bench_hook::install(console);
     crate::wake::install(move || console.tick());

@@ -16,6 +16,8 @@
 //! - `plmBench.ackSamples()`: the most recent ACK latencies one by one,
 //!   `[[writtenMs, linkMs, pageMs], …]`, `writtenMs` on the page's clock
 //!   (`performance.now()`) when the tick that wrote the ACK began.
+//! - `plmBench.streetSeconds()`: the street's clock, s (a simulated
+//!   street's virtual time), for journeys that wait for simulated time.
 
 use crate::clock::page_now_us;
 use crate::session::{Outcome, Spread};
@@ -44,15 +46,19 @@ pub fn install(c: Console) {
     );
     let ack_latency = Closure::<dyn Fn() -> JsValue>::new(move || ack_latency(c));
     let ack_samples = Closure::<dyn Fn() -> JsValue>::new(move || ack_samples(c));
+    let street_seconds =
+        Closure::<dyn Fn() -> f64>::new(move || c.street.read(|s| s.now()) as f64 / 1e6);
     let _ = Reflect::set(&hook, &"setBaud".into(), set_baud.as_ref());
     let _ = Reflect::set(&hook, &"mibReads".into(), mib_reads.as_ref());
     let _ = Reflect::set(&hook, &"ackLatency".into(), ack_latency.as_ref());
     let _ = Reflect::set(&hook, &"ackSamples".into(), ack_samples.as_ref());
+    let _ = Reflect::set(&hook, &"streetSeconds".into(), street_seconds.as_ref());
     // The page keeps them for its whole life.
     set_baud.forget();
     mib_reads.forget();
     ack_latency.forget();
     ack_samples.forget();
+    street_seconds.forget();
     let _ = Reflect::set(&window, &"plmBench".into(), &hook);
 }
 

@@ -20,6 +20,7 @@ use plm_core::link::LocalFrame;
 use plm_core::link::Timeouts;
 use plm_core::st7580::{Command, TxParams};
 use plm_core::time::Instant;
+use plm_sim::StreetProfile;
 use std::cell::RefCell;
 use std::collections::{BTreeMap, VecDeque};
 use std::rc::Rc;
@@ -127,6 +128,10 @@ pub struct SimStore {
     /// How much faster than the page's clock a simulated street runs
     /// (`?speed=N`, demos and tests; 1 by default).
     pub speed: RwSignal<u32>,
+    /// Every lamp of the simulated street alike (`?street=uniform`, for
+    /// tests that count exact values); else its lamps differ as a real
+    /// street's do (plm-sim's `profile`).
+    pub uniform: RwSignal<bool>,
     /// The simulated ST7570 Servers, as the Network view shows them.
     pub servers: RwSignal<Vec<crate::transport::sfsk::SimServer>>,
 }
@@ -275,6 +280,7 @@ pub fn provide_console() -> Console {
             line_events: signal(Vec::new()),
             servers: signal(Vec::new()),
             speed: signal(1),
+            uniform: signal(false),
         },
         street: StreetStore {
             session: StoredValue::new_local(Rc::new(RefCell::new(StreetSession::idle()))),
@@ -330,6 +336,10 @@ impl Console {
                 profile.attach(),
                 baud,
                 SIM_SEED,
+                match self.sim.uniform.get_untracked() {
+                    true => StreetProfile::Uniform,
+                    false => StreetProfile::Realistic,
+                },
             );
             street.set_failure_rate(f64::from_bits(self.sim.failure_rate.get_untracked()));
             Box::new(street)

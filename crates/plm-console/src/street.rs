@@ -812,13 +812,19 @@ mod tests {
     use crate::transport::LampAction;
     use plm_core::st7580::TxParams;
     use plm_sim::board::street_address;
-    use plm_sim::Attach;
+    use plm_sim::{Attach, StreetProfile};
 
     const S: Duration = 1_000 * MS;
     const LAMPS: usize = 50;
 
     fn session(via: Attach) -> StreetSession {
-        let t = Box::new(SimTransport::street(LAMPS, via, 57_600, 3));
+        let t = Box::new(SimTransport::street(
+            LAMPS,
+            via,
+            57_600,
+            3,
+            StreetProfile::Uniform,
+        ));
         let conc = match via {
             Attach::Board => Concentrator::usart(RequesterConfig::default()),
             Attach::Modem => Concentrator::modem(
@@ -983,7 +989,13 @@ mod tests {
     #[test]
     fn a_street_remembered_is_read_at_once_and_only_new_lamps_are_looked_for() {
         let usart = || Concentrator::usart(RequesterConfig::default());
-        let t = Box::new(SimTransport::street(6, Attach::Board, 57_600, 5));
+        let t = Box::new(SimTransport::street(
+            6,
+            Attach::Board,
+            57_600,
+            5,
+            StreetProfile::Uniform,
+        ));
         let mut s = StreetSession::new(t, usart());
         let late = street_address(6);
         let sim = s.transport_mut().unwrap().simulator().unwrap();
@@ -1041,7 +1053,13 @@ mod tests {
     #[test]
     fn a_lamp_powered_later_is_found_by_the_sweep() {
         let usart = Concentrator::usart(RequesterConfig::default());
-        let t = Box::new(SimTransport::street(6, Attach::Board, 57_600, 7));
+        let t = Box::new(SimTransport::street(
+            6,
+            Attach::Board,
+            57_600,
+            7,
+            StreetProfile::Uniform,
+        ));
         let mut s = StreetSession::new(t, usart);
         let late = street_address(4);
         let sim = s.transport_mut().unwrap().simulator().unwrap();
@@ -1071,7 +1089,13 @@ mod tests {
     /// session.
     #[test]
     fn a_street_remembered_empty_is_discovered_again() {
-        let t = Box::new(SimTransport::street(3, Attach::Board, 57_600, 6));
+        let t = Box::new(SimTransport::street(
+            3,
+            Attach::Board,
+            57_600,
+            6,
+            StreetProfile::Uniform,
+        ));
         let mut s = StreetSession::new(t, Concentrator::usart(RequesterConfig::default()));
         s.recall(4, Vec::new());
         assert_eq!(s.remembered().0, 5);
@@ -1085,7 +1109,13 @@ mod tests {
     #[test]
     fn random_failures_at_the_rate_set_are_raised() {
         let failures_at = |rate: f64| {
-            let t = Box::new(SimTransport::street(6, Attach::Board, 57_600, 4));
+            let t = Box::new(SimTransport::street(
+                6,
+                Attach::Board,
+                57_600,
+                4,
+                StreetProfile::Uniform,
+            ));
             let mut s = StreetSession::new(t, Concentrator::usart(RequesterConfig::default()));
             s.discover();
             run(&mut s, 30 * S);

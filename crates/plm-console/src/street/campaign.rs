@@ -192,13 +192,19 @@ mod tests {
     use plm_core::time::{Duration, MS};
     use plm_sim::board::street_address;
     use plm_sim::rfu::{firmware_image, plain_image};
-    use plm_sim::Attach;
+    use plm_sim::{Attach, StreetProfile};
 
     const S: Duration = 1_000 * MS;
     const NEW: Release = Release { major: 1, minor: 9 };
 
     fn street(lamps: usize) -> StreetSession {
-        let t = Box::new(SimTransport::street(lamps, Attach::Board, 57_600, 5));
+        let t = Box::new(SimTransport::street(
+            lamps,
+            Attach::Board,
+            57_600,
+            5,
+            StreetProfile::Uniform,
+        ));
         StreetSession::new(t, Concentrator::usart(RequesterConfig::default()))
     }
 

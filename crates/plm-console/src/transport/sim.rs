@@ -6,7 +6,9 @@ use super::{LampAction, LinkState, Simulator, Transport};
 use plm_core::app::Address;
 use plm_core::time::Instant;
 use plm_sim::board::street_address;
-use plm_sim::{Attach, ByteFaults, Dir, Fault, LineConfig, LineEvent, Sim, SimConfig};
+use plm_sim::{
+    Attach, ByteFaults, Dir, Fault, LineConfig, LineEvent, Sim, SimConfig, StreetProfile,
+};
 
 /// A simulated modem on node 0 of a simulated power line.
 #[derive(Debug, Clone)]
@@ -29,12 +31,14 @@ impl SimTransport {
     }
 
     /// A street of `lamps` street-light boards behind a concentrator
-    /// board's USART, or behind a bare modem (`via`).
-    pub fn street(lamps: usize, via: Attach, baud: u32, seed: u64) -> Self {
+    /// board's USART, or behind a bare modem (`via`), its lamps alike or
+    /// differing as a real street's (`profile`).
+    pub fn street(lamps: usize, via: Attach, baud: u32, seed: u64, profile: StreetProfile) -> Self {
         SimTransport {
             sim: Sim::new(SimConfig {
                 seed,
                 baud,
+                profile,
                 ..SimConfig::street(lamps, via)
             }),
         }
