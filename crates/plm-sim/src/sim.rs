@@ -11,6 +11,21 @@
 //! [`Board`] (its USART). Every other node's host is an [`EchoHost`] that
 //! sends back what its modem hears, or, on a street ([`Peers::Street`]),
 //! a street-light [`Board`] with its lamp.
+//!
+//! Nothing is ticked. The event queue holds what crosses a wire or the
+//! line, at its time; each modem and host says when it next has something
+//! to do (its `poll_timeout`), filed among the timers by node, and runs
+//! only then or when an event reaches it (only that node is looked at
+//! afterwards). A modem's write to its board (or echoing host) is one
+//! event, at the arrival of the write's last byte: the host still takes
+//! each byte at its own arrival time, so its UART timing rules (T_IC
+//! between characters, UM0932 3.2.6, and the timing of repeats) hold, and
+//! when a deadline of the host falls inside a write the bytes before it
+//! are taken first. A frame's end at its receivers is one event too, run
+//! at each receiver in node order. A board hearing a frame that is not
+//! for it costs about four events (the frame's end, the modem's
+//! indication, the board's ACK back, the modem's deadline); a quiet
+//! street costs none ([`Sim::events_run`]).
 
 use crate::ballast::BallastConfig;
 use crate::board::{street_address, Board, BoardConfig};
@@ -364,6 +379,8 @@ pub struct Sim {
     /// (older ones are dropped when they come to the top): a heap, so
     /// that the console's wasm carries no B-tree code for it.
     timers: BinaryHeap<Reverse<(Instant, usize)>>,
+    /// Events run so far ([`Sim::events_run`]).
+    events_run: u64,
 }
 
 impl Sim {
@@ -459,6 +476,7 @@ impl Sim {
             is_dirty: Vec::new(),
             deadlines: Vec::new(),
             timers: BinaryHeap::new(),
+            events_run: 0,
         };
         let n = sim.nodes.len();
         sim.is_dirty = vec![false; n];
@@ -831,6 +849,13 @@ impl Sim {
         )
     }
 
+    /// Events run so far: a byte, a modem's write reaching its board, a
+    /// frame ending at one receiver, a component's deadline each count
+    /// one. What a street costs, for tests and benchmarks.
+    pub fn events_run(&self) -> u64 {
+        self.events_run
+    }
+
     /// Runs everything due up to `t`, then sets the clock to `t`.
     pub fn advance_to(&mut self, t: Instant) {
         while let Some(d) = self.next_deadline() {
@@ -881,6 +906,7 @@ impl Sim {
         let now = self.now;
         while self.queue.peek().is_some_and(|s| s.0.at <= now) {
             let Reverse(s) = self.queue.pop().expect("peeked");
+            self.events_run += 1;
             self.dispatch(s.ev);
             self.flush();
         }
@@ -894,6 +920,7 @@ impl Sim {
                 // Filed again by `touch` below if still due later.
                 self.deadlines[node] = None;
                 due.push(node);
+                self.events_run += 1;
             }
         }
         self.drop_stale_timers();
@@ -980,6 +1007,7 @@ impl Sim {
             Ev::TxStart(tx) => self.start_transmission(*tx),
             Ev::RxEnd { id, nodes } => {
                 // One after another, as if each had its own event.
+                self.events_run += (nodes.len() as u64).saturating_sub(1);
                 for node in nodes {
                     self.touch(node);
                     self.end_reception(node, id);

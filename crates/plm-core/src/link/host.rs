@@ -304,8 +304,10 @@ impl HostEngine {
             }
             // Each element as its last byte completes it: a repeat is told
             // from a new frame by when its first byte came.
-            for e in out.drain(..) {
-                self.on_element(now, e);
+            if !out.is_empty() {
+                for e in out.drain(..) {
+                    self.on_element(now, e);
+                }
             }
         }
         self.advance(now);
