@@ -26,7 +26,7 @@ const sri = (body) => `sha384-${crypto.createHash('sha384').update(body).digest(
 /**
  * The glue without the wasm-streams classes (IntoUnderlyingSource, -Sink,
  * -ByteSource) that Leptos's server functions bring and the console never
- * uses: index.html's wasm-opt options stop exporting them from the wasm.
+ * uses: the linker (.cargo/wasm-ld.sh) does not export them from the wasm.
  * Each is the class, its `Symbol.dispose` line and its finalization
  * registry, as wasm-bindgen writes them; anything of them left over is an
  * error (a new wasm-bindgen writing them otherwise).
