@@ -209,10 +209,10 @@ fn lamp(p: &Place, x: i32, y: i32, cy: i32, w: i32, named: bool) -> String {
     g.push_str(&mark(look, cx, cy, r));
     let bar = |at: i32, full: i32| {
         let len = snr.map_or(0, |s| (i32::from(s).clamp(0, SNR_FULL) * full) / SNR_FULL);
+        // Named, the bar leaves room for its figure on its right.
+        let x = if named { cx - 40 } else { cx - full / 2 };
         format!(
-            "<rect class=\"pk-track\" x=\"{}\" y=\"{at}\" width=\"{full}\" height=\"3\"/><rect class=\"pk-snr\" x=\"{}\" y=\"{at}\" width=\"{len}\" height=\"3\"/>",
-            cx - full / 2,
-            cx - full / 2
+            "<rect class=\"pk-track\" x=\"{x}\" y=\"{at}\" width=\"{full}\" height=\"3\"/><rect class=\"pk-snr\" x=\"{x}\" y=\"{at}\" width=\"{len}\" height=\"3\"/>"
         )
     };
     if named {
@@ -238,7 +238,14 @@ fn lamp(p: &Place, x: i32, y: i32, cy: i32, w: i32, named: bool) -> String {
                 y + 62
             ));
         }
-        g.push_str(&bar(y + 67, 60));
+        g.push_str(&bar(y + 67, 50));
+        if let Some(s) = snr {
+            g.push_str(&format!(
+                "<text class=\"pk-small pk-db\" x=\"{}\" y=\"{}\">{s} dB</text>",
+                cx + 14,
+                y + 71
+            ));
+        }
     } else {
         g.push_str(&bar(y + 19, 16));
     }
@@ -348,7 +355,8 @@ mod tests {
         // Twelve named lamps in one row, each with its SNR bar (20 of 30 dB).
         assert!(html.contains("viewBox=\"0 0 1320 76\""), "{html}");
         assert_eq!(html.matches("class=\"pk-snr\"").count(), 12);
-        assert!(html.contains("width=\"40\" height=\"3\""));
+        assert!(html.contains("width=\"33\" height=\"3\""));
+        assert_eq!(html.matches(">20 dB</text>").count(), 12);
         assert!(html.contains("running 12"));
     }
 

@@ -1,7 +1,10 @@
 //! The Street view: the fleet of lamps (discover, a background sweep, a
 //! sortable and filterable table with failed and unreachable lamps
 //! standing out, CSV and JSON export), dimming and clocks for a selection
-//! or all, alerts; a lamp's own page is [`super::lamp`].
+//! or all, alerts; a lamp's own page is [`super::lamp`]; the street
+//! picture and its pole list are [`picture`].
+
+mod picture;
 
 use super::files::download;
 use super::widgets::{
@@ -63,6 +66,7 @@ pub fn StreetView() -> impl IntoView {
                 {button("street-export-csv", "Export CSV", "", move || export(false))}
                 {button("street-export-json", "Export JSON", "", move || export(true))}
             </div>
+            <picture::StreetPicture focus=focus/>
             <p class="muted" id="street-protocol">"Discover and Firmware update need boards that speak this console's board protocol (docs/board-protocol.md), as the simulated ones do; a board on ST's own firmware answers only the manual's commands."</p>
             <p class="muted" id="street-energy">{move || {
                 street.version.track();
