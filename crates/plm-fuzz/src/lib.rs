@@ -27,6 +27,7 @@ pub const TARGETS: &[(&str, Target)] = &[
     ("json_lines", targets::json_lines),
     ("rfu_image", targets::rfu_image),
     ("saved_campaign", targets::saved_campaign),
+    ("pole_list", targets::pole_list),
     ("rfc2217", targets::rfc2217),
     ("host_engine", targets::host_engine),
     ("device_engine", targets::device_engine),

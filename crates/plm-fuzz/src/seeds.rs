@@ -146,7 +146,37 @@ pub fn all(root: &Path) -> Result<Vec<Seed>, String> {
         ));
     }
     seeds.extend(rfc2217_sessions());
+    seeds.extend(pole_lists());
     Ok(seeds)
+}
+
+/// Pole lists as people write them: a header, positions, quoted names,
+/// semicolons; and a street of 500 lamps.
+fn pole_lists() -> Vec<Seed> {
+    let street: String = (1..=500u64)
+        .map(|n| {
+            format!(
+                "{},P{n},{}\r\n",
+                Address::from_u64(0x0080_E100_0000 + n),
+                n * 30
+            )
+        })
+        .collect();
+    [
+        (
+            "header",
+            "address,pole,position m\n0080e1000002,P1,0\n0080e1000001,\"Rue Haute, 2\",35\n"
+                .to_string(),
+        ),
+        (
+            "semicolons",
+            "0080e1000001;\"Le \"\"Grand\"\" m\u{e2}t\";\n00:80:e1:00:00:03;P3;120\n".to_string(),
+        ),
+        ("street-500", street),
+    ]
+    .into_iter()
+    .map(|(name, text)| ("pole_list", name.to_string(), text.into_bytes()))
+    .collect()
 }
 
 /// What `plm board` and pyserial send `plm sim`: negotiation, the baud

@@ -8,6 +8,7 @@ use plm_core::app::update::Update;
 use plm_core::app::{AppFrame, LineFrame, Message, UsartDecoder};
 use plm_core::decode::{self, Decoded, Decoder, LineDecoded};
 use plm_core::decode_app::{self, AppDecoded};
+use plm_core::file::poles;
 use plm_core::json::{self, Json};
 use plm_core::link::device::DeviceEngine;
 use plm_core::link::host::{HostConfig, HostEngine};
@@ -197,6 +198,35 @@ pub fn saved_campaign(data: &[u8]) {
         }
         let _ = (update.bytes_sent(), update.time_left(now), update.report());
         now += 100 * MS;
+    }
+}
+
+/// A pole list file (the Street view's import): read, and what it
+/// accepts holds what the picture relies on: at least one pole, each lamp
+/// once, a name of 1 to [`poles::NAME_MAX`] characters, positions within
+/// the bound that never go back along the street.
+pub fn pole_list(data: &[u8]) {
+    let Ok(list) = poles::parse(data) else {
+        return;
+    };
+    assert!(!list.is_empty(), "a list accepted with no pole");
+    let mut last = 0;
+    for (i, p) in list.iter().enumerate() {
+        assert!(
+            list[..i].iter().all(|q| q.address != p.address),
+            "{} listed twice",
+            p.address
+        );
+        let chars = p.name.chars().count();
+        assert!((1..=poles::NAME_MAX).contains(&chars), "name {:?}", p.name);
+        assert_eq!(p.name.trim(), p.name, "a name kept with its spaces");
+        if let Some(m) = p.position {
+            assert!(
+                m >= last && m <= poles::POSITION_MAX,
+                "position {m} after {last}"
+            );
+            last = m;
+        }
     }
 }
 
