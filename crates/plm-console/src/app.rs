@@ -75,6 +75,10 @@ pub fn App() -> impl IntoView {
         }
     });
     on_cleanup(move || on_leave.remove());
+    // The lamps' readings are written as the page is left: a reload
+    // keeps them.
+    let on_hide = window_event_listener(leptos::ev::pagehide, move |_| street.keep_history(true));
+    on_cleanup(move || on_hide.remove());
 
     view! {
         <div class="app">

@@ -36,6 +36,7 @@ pub mod transport;
 pub mod app;
 pub mod bench_hook;
 pub mod campaign_store;
+pub mod history_store;
 pub mod stores;
 pub mod street_store;
 pub mod views;

@@ -3,6 +3,7 @@
 //! session's [`Note`]s to them.
 
 use crate::clock::page_now_us;
+use crate::history_store;
 use crate::profile::Profile;
 use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
 use crate::storage::load;
@@ -191,6 +192,12 @@ impl StreetStore {
         f(&self.session().borrow())
     }
 
+    /// Writes the lamps' readings to the browser's storage, at a modest
+    /// rate, or at once if `now` (`history_store::keep`).
+    pub fn keep_history(&self, now: bool) {
+        self.with_fleet(|f| history_store::keep(f, page_now_us(), now));
+    }
+
     /// Acts on the street session; the console shows what changed at
     /// its next tick, which comes at once.
     pub fn act<R>(&self, f: impl FnOnce(&mut StreetSession) -> R) -> R {
@@ -368,6 +375,8 @@ impl Console {
     pub fn connect_transport(&self, transport: Box<dyn Transport>) {
         let profile = self.profile.get_untracked();
         let mut problem = None;
+        // The street left behind keeps its readings.
+        self.street.keep_history(true);
         if profile.is_street() {
             self.session()
                 .borrow_mut()
@@ -404,6 +413,9 @@ impl Console {
                     street.discover();
                 }
             }
+            if let Some(p) = history_store::start(&id, street.now()) {
+                problem = Some(problem.map_or(p.clone(), |q| format!("{q} {p}")));
+            }
             self.street.kept_as.set(id);
             *self.street.session().borrow_mut() = street;
             self.street.alerts.set(VecDeque::new());
@@ -412,6 +424,7 @@ impl Console {
             *self.street.session().borrow_mut() = StreetSession::idle();
             self.street.port.set(String::new());
             self.street.kept_as.set(String::new());
+            history_store::start("", 0);
             self.session()
                 .borrow_mut()
                 .replace_transport(Some(transport), profile.dialect());
@@ -756,6 +769,7 @@ impl Console {
         if changed {
             street.now.set(now);
             street.version.update(|v| *v += 1);
+            street.keep_history(false);
         }
         if sent > 0 {
             street.sent.update(|n| *n += sent);

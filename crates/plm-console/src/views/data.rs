@@ -6,9 +6,9 @@
 use super::snr_plot::{self, Point};
 use super::widgets::{set_checked, set_value, signal, text_input, text_table};
 use super::{millis, seconds, spaced};
-use crate::tab::Tab;
 use crate::session::Outcome;
 use crate::stores::{refusal, use_console};
+use crate::tab::Tab;
 use crate::traffic::Entry;
 use leptos::prelude::*;
 use plm_core::json::Json;
@@ -371,8 +371,11 @@ fn Indications(tab: RwSignal<String>) -> impl IntoView {
             <p class="muted">
                 "Data and sniffer indications from the modem (UM0932 Table 39). With echoing peers (Simulator view) every frame sent comes back."
             </p>
-            // The plot, or why there is none, written as HTML in one go.
-            <div inner_html=move || {
+            // The plot, or why there is none, written as HTML in one go;
+            // the reading under the pointer.
+            <div on:mousemove=super::plot::follow(Box::new(move |_, share| {
+                rows.with_untracked(|(_, r)| snr_plot::readout(&snr_plot::layout(&snr_points(r))?, share))
+            })) inner_html=move || {
                 rows.with(|(_, r)| match snr_plot::layout(&snr_points(r)) {
                     Some(plot) => snr_plot::draw(&plot),
                     None if r.is_empty() => {

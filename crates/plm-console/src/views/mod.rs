@@ -9,6 +9,7 @@ pub mod files;
 pub mod lamp;
 pub mod modem;
 pub mod network;
+pub mod plot;
 pub mod serial_port;
 pub mod sfsk_data;
 pub mod sfsk_setup;
