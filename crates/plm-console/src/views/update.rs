@@ -15,9 +15,21 @@ use crate::stores::{use_console, StreetStore};
 use leptos::prelude::*;
 use plm_core::app::rfu::image::{self, Image};
 use plm_core::app::{Address, Release};
+use std::cell::RefCell;
+
+thread_local! {
+    /// The image chosen, kept out of the reactive graph: a signal of its
+    /// own type would bring its own signal code (docs/console.md, "Size").
+    /// The view's `chosen` counter tells when it changes.
+    static CHOSEN: RefCell<Option<Chosen>> = const { RefCell::new(None) };
+}
+
+/// `f` of the image chosen.
+fn with_chosen<R>(f: impl FnOnce(Option<&Chosen>) -> R) -> R {
+    CHOSEN.with_borrow(|c| f(c.as_ref()))
+}
 
 /// The image chosen, and what its check said.
-#[derive(Clone)]
 struct Chosen {
     name: String,
     bytes: Vec<u8>,
@@ -80,7 +92,15 @@ fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
 #[component]
 pub fn UpdateView() -> impl IntoView {
     let street = use_console().street;
-    let chosen = signal(None::<Chosen>);
+    let chosen = signal(0u32);
+    let choose = move |c: Chosen| {
+        CHOSEN.with_borrow_mut(|x| *x = Some(c));
+        chosen.set(chosen.get_untracked().wrapping_add(1));
+    };
+    let checked = move |ok: bool| {
+        chosen.track();
+        with_chosen(|c| c.is_some_and(|c| c.check.is_ok() == ok))
+    };
     let choice = signal(String::from("all"));
     let message = signal(None::<String>);
     let make_release = signal(String::from("1.5"));
@@ -97,7 +117,7 @@ pub fn UpdateView() -> impl IntoView {
         };
         leptos::task::spawn_local(async move {
             match read_bytes(&file).await {
-                Ok(bytes) => chosen.set(Some(Chosen::of(file.name(), bytes))),
+                Ok(bytes) => choose(Chosen::of(file.name(), bytes)),
                 Err(e) => message.set(Some(e)),
             }
         });
@@ -129,11 +149,11 @@ pub fn UpdateView() -> impl IntoView {
                 plm_sim::rfu::plain_image(0, size),
             ),
         };
-        chosen.set(Some(Chosen::of(name, bytes)));
+        choose(Chosen::of(name, bytes));
         message.set(None);
     };
     let start = move || {
-        let Some(c) = chosen.get_untracked() else {
+        let Some(bytes) = with_chosen(|c| c.map(|c| c.bytes.clone())) else {
             return message.set(Some("choose an image file first".into()));
         };
         let said = match release(&stated.get_untracked()) {
@@ -141,7 +161,7 @@ pub fn UpdateView() -> impl IntoView {
             Err(e) => return message.set(Some(format!("nothing sent: {e}"))),
         };
         let list = targets(street, &choice.get_untracked());
-        let r = street.act(|s| s.start_update(c.bytes, said, &list));
+        let r = street.act(|s| s.start_update(bytes, said, &list));
         message.set(Some(match r {
             Ok(()) => format!("update started on {} lamp(s)", list.len()),
             Err(e) => format!("nothing sent: {e}"),
@@ -193,17 +213,18 @@ pub fn UpdateView() -> impl IntoView {
                 {text_input("update-make-size", "", "", Some(6), make_size)}
                 {button("update-make", "Make image", "a firmware image the simulated boards run", make)}
                 {button("update-save-image", "Save image file", "", move || {
-                    if let Some(c) = chosen.get_untracked() {
-                        let _ = download_bytes(&c.name, &c.bytes);
-                    }
+                    let _ = with_chosen(|c| c.map(|c| download_bytes(&c.name, &c.bytes)));
                 })}
             </div>
             <p
                 id="update-image"
                 class="message"
-                class:error=move || chosen.with(|c| matches!(c, Some(Chosen { check: Err(_), .. })))
+                class:error=move || checked(false)
             >
-                {move || chosen.with(|c| c.as_ref().map_or("no image chosen".into(), Chosen::words))}
+                {move || {
+                    chosen.track();
+                    with_chosen(|c| c.map_or("no image chosen".into(), Chosen::words))
+                }}
             </p>
             <div class="toolbar">
                 <label title="a plain .bin names no release; a file with a descriptor must name the same">
@@ -221,7 +242,7 @@ pub fn UpdateView() -> impl IntoView {
                 {live_button(
                     "update-start",
                     Box::new(|| "Start update".to_string()),
-                    Box::new(move || running() == Some(true) || !chosen.with(|c| matches!(c, Some(Chosen { check: Ok(_), .. })))),
+                    Box::new(move || running() == Some(true) || !checked(true)),
                     Box::new(start),
                 )}
             </div>
