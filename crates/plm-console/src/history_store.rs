@@ -171,7 +171,9 @@ pub fn merge(kept: &[Sample], epoch: Instant, live: &VecDeque<Sample>) -> Vec<Sa
 struct State {
     id: String,
     epoch: Instant,
-    kept: BTreeMap<Address, Vec<Sample>>,
+    /// A list, not a map: no ordered map of its own in the page's wasm
+    /// (docs/console.md, "Size").
+    kept: Kept,
     written_at: Option<f64>,
 }
 
@@ -206,7 +208,7 @@ pub fn start(id: &str, now: Instant) -> Option<String> {
         *s = State {
             id: id.to_string(),
             epoch,
-            kept: kept.into_iter().collect(),
+            kept,
             written_at: None,
         }
     });
@@ -217,7 +219,11 @@ pub fn start(id: &str, now: Instant) -> Option<String> {
 /// from before, then the session's.
 pub fn of(lamp: &Lamp) -> Vec<Sample> {
     STATE.with_borrow(|s| {
-        let kept = s.kept.get(&lamp.address).map_or(&[][..], |k| &k[..]);
+        let kept = s
+            .kept
+            .iter()
+            .find(|(a, _)| *a == lamp.address)
+            .map_or(&[][..], |(_, k)| &k[..]);
         merge(kept, s.epoch, &lamp.history)
     })
 }

@@ -51,12 +51,12 @@ fn output_levels(config: u8, levels: u8) -> Result<u8, String> {
 /// it for the unit, below it for the clock times.
 const FRAME: Frame = Frame {
     width: 316.0,
-    height: 110.0,
+    height: 86.0,
     left: 34.0,
     right: 308.0,
-    top: 16.0,
-    bottom: 90.0,
-    inset: 4.0,
+    top: 14.0,
+    bottom: 68.0,
+    inset: 6.0,
 };
 
 /// Readings further apart than this are not joined: the page was closed
@@ -145,7 +145,7 @@ impl Chart {
             &mut h,
             "plot-unit",
             FRAME.left - 5.0,
-            FRAME.top - 7.0,
+            FRAME.top - 3.0,
             "",
             unit,
         );

@@ -161,7 +161,12 @@ pub fn layout(points: &[Point]) -> Option<Plot> {
         (n, all) if n == all => format!("{n} indications"),
         (n, all) => format!("the last {n} of {all} indications"),
     };
-    let count = format!("{count}, SNR min {s0} dB, max {s1} dB");
+    // Whole dB, written out (std's float printing costs the page's wasm).
+    let count = format!(
+        "{count}, SNR min {} dB, max {} dB",
+        super::fixed(s0, 0),
+        super::fixed(s1, 0)
+    );
     Some(Plot {
         x,
         y,
