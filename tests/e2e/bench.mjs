@@ -15,6 +15,10 @@
 // - The Street view's frame time with a simulated street of 500 lamps
 //   (`?lamps=500`): requestAnimationFrame intervals while the console
 //   discovers and sweeps the street, against a 60 fps frame (16.7 ms).
+//   Over the same time, that street's speed in the page's wasm: the
+//   simulated seconds its ticks ran per wall second they took (the
+//   simulator and the concentrator, not the views: `plmBench.streetWork`),
+//   against the 5× target.
 //
 // The page is driven through `window.plmBench` (crates/plm-console/src/
 // bench_hook.rs), so the figures are the session's, not a script's clicks.
@@ -55,6 +59,8 @@ const CHIPS = [
 const STREET_LAMPS = 500;
 /** How long its frames are recorded. */
 const STREET_MEASURE_MS = 20_000;
+/** Simulated seconds per wall second a 500-lamp street must reach in the page. */
+const STREET_SPEED_TARGET = 5;
 /** One frame at 60 fps. */
 const FRAME_MS = 1000 / 60;
 /**
@@ -250,10 +256,12 @@ async function streetFrames(browser, base) {
   await page.locator('#fleet-table').waitFor();
   // Let discovery fill the table, then measure while the sweep runs.
   await page.waitForFunction(
-    (n) => document.querySelectorAll('#fleet-table tbody tr').length >= n,
+    // The table draws only the rows in view: `data-rows` counts them all.
+    (n) => Number(document.querySelector('#fleet-table')?.dataset.rows ?? 0) >= n,
     Math.round(STREET_LAMPS * 0.8),
     { timeout: 900_000, polling: 1000 },
   );
+  const workBefore = await page.evaluate(() => window.plmBench.streetWork());
   const frames = await page.evaluate(
     (ms) =>
       new Promise((resolve) => {
@@ -270,14 +278,26 @@ async function streetFrames(browser, base) {
       }),
     STREET_MEASURE_MS,
   );
-  const rows = await page.locator('#fleet-table tbody tr').count();
+  const workAfter = await page.evaluate(() => window.plmBench.streetWork());
+  const simulated = workAfter.simulatedS - workBefore.simulatedS;
+  const speed = simulated / (workAfter.wallS - workBefore.wallS);
+  const rows = Number(await page.getAttribute('#fleet-table', 'data-rows'));
   const progress = await page.textContent('#street-progress');
   await page.screenshot({ path: path.join(artifacts, 'bench-street-500.png') });
   await page.close();
   if (errors.length) throw new Error(`errors in the street page: ${errors.join('; ')}`);
   frames.sort((a, b) => a - b);
   const at = (p) => frames[Math.min(frames.length - 1, Math.ceil((frames.length * p) / 100) - 1)];
-  return { rows, progress, n: frames.length, p50: at(50), p99: at(99), max: frames[frames.length - 1] };
+  return {
+    rows,
+    progress,
+    n: frames.length,
+    p50: at(50),
+    p99: at(99),
+    max: frames[frames.length - 1],
+    simulated,
+    speed,
+  };
 }
 
 /**
@@ -393,6 +413,7 @@ async function main() {
         ? [
             `Street view, ${street.rows} of ${STREET_LAMPS} lamps in the table (${street.progress}), ${street.n} frames over ${STREET_MEASURE_MS / 1000} s:`,
             `  frame time p50 ${msText(street.p50)} (ratio ${(street.p50 / FRAME_MS).toFixed(2)} of a 60 fps frame)   p99 ${msText(street.p99)} (ratio ${(street.p99 / FRAME_MS).toFixed(2)})   max ${msText(street.max)}`,
+            `  simulation in the page: ${street.speed.toFixed(1)} simulated seconds per wall second (ratio ${(street.speed / STREET_SPEED_TARGET).toFixed(2)} of the ${STREET_SPEED_TARGET}× target, ${street.speed >= STREET_SPEED_TARGET ? 'met' : 'NOT met'}; ${street.simulated.toFixed(1)} s simulated, the street's ticks only)`,
           ]
         : ['Street view: left out (PLM_BENCH_STREET=0)']),
       '',

@@ -52,7 +52,7 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
-            name: "street: discover and read 12, 100 and 500 lamps, sweep 500, firmware update (native)",
+            name: "street: discover and read 12, 100 and 500 lamps, sweep 500 (simulated s per wall s), firmware update (native)",
             sources: &["crates/plm-sim/examples/bench_street.rs"],
             cmd: Cmd::new("cargo").args([
                 "run",
@@ -95,7 +95,7 @@ fn benches() -> Vec<Bench> {
         },
         Bench {
             name:
-                "console in Chromium: ACK latency, MIB-read rate, Street view with 500 lamps, size",
+                "console in Chromium: ACK latency, MIB-read rate, Street view with 500 lamps (frame time, simulated s per wall s), size",
             sources: &["tests/e2e/bench.mjs"],
             cmd: Cmd::new("node").args(["tests/e2e/bench.mjs"]),
             needs_dist: true,

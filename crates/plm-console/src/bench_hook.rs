@@ -18,6 +18,9 @@
 //!   (`performance.now()`) when the tick that wrote the ACK began.
 //! - `plmBench.streetSeconds()`: the street's clock, s (a simulated
 //!   street's virtual time), for journeys that wait for simulated time.
+//! - `plmBench.streetWork()`: the street's time its ticks have run and
+//!   the page's time that took (`StreetSession::work`), `{simulatedS,
+//!   wallS}`: a simulated street's speed in the page.
 
 use crate::clock::page_now_us;
 use crate::session::{Outcome, Spread};
@@ -52,13 +55,22 @@ pub fn install(c: Console) {
     let _ = Reflect::set(&hook, &"mibReads".into(), mib_reads.as_ref());
     let _ = Reflect::set(&hook, &"ackLatency".into(), ack_latency.as_ref());
     let _ = Reflect::set(&hook, &"ackSamples".into(), ack_samples.as_ref());
+    let street_work = Closure::<dyn Fn() -> JsValue>::new(move || {
+        let (simulated, wall) = c.street.read(|s| s.work());
+        object(&[
+            ("simulatedS", (simulated as f64 / 1e6).into()),
+            ("wallS", (wall / 1e6).into()),
+        ])
+    });
     let _ = Reflect::set(&hook, &"streetSeconds".into(), street_seconds.as_ref());
+    let _ = Reflect::set(&hook, &"streetWork".into(), street_work.as_ref());
     // The page keeps them for its whole life.
     set_baud.forget();
     mib_reads.forget();
     ack_latency.forget();
     ack_samples.forget();
     street_seconds.forget();
+    street_work.forget();
     let _ = Reflect::set(&window, &"plmBench".into(), &hook);
 }
 

@@ -170,6 +170,10 @@ pub struct StreetSession {
     decoder: Decoder,
     out: StreetTick,
     campaign: Option<Campaign>,
+    /// Transport time run by [`StreetSession::tick`] since the session
+    /// began, and the page's time (µs) that took: the street's speed
+    /// ([`StreetSession::work`]).
+    work: (Duration, f64),
 }
 
 impl StreetSession {
@@ -193,6 +197,7 @@ impl StreetSession {
             decoder: Decoder::new(Dialect::St7580, Source::Any),
             out: StreetTick::default(),
             campaign: None,
+            work: (0, 0.0),
         }
     }
 
@@ -233,6 +238,13 @@ impl StreetSession {
     /// The transport's clock.
     pub fn now(&self) -> Instant {
         self.transport.as_ref().map_or(0, |t| t.now())
+    }
+
+    /// Transport time the page's ticks have run (µs), and the page's
+    /// time that took (µs, the views' not counted): with a simulated
+    /// street, its simulated seconds per wall second.
+    pub fn work(&self) -> (Duration, f64) {
+        self.work
     }
 
     /// The lamps known so far.
@@ -427,7 +439,10 @@ impl StreetSession {
         }
         if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
             let target = self.pacer.target(page_us, start);
+            let began = crate::clock::page_now_us();
             self.run_within(start, target, budget);
+            self.work.0 += self.now().saturating_sub(start);
+            self.work.1 += crate::clock::page_now_us() - began;
         }
         self.take()
     }
