@@ -141,3 +141,32 @@ test('a pole list orders the picture and is kept; a malformed one is refused wit
   assert.deepEqual(await order(page), [...descending].reverse());
   assert.equal(await page.evaluate(() => localStorage.getItem('plm-console.poles')), null);
 });
+
+test('a long street: small marks in rows that wrap, the picture in view', async (t) => {
+  const context = await browser.newContext({ viewport: { width: 1366, height: 768 } });
+  const page = await watchedPage(t, context);
+  await page.goto(`${base}?lamps=500`);
+  // Lamps appear as discovery hears them; a hundred are enough to see the layout.
+  await page.waitForFunction(() => document.querySelectorAll('#street-picture g[data-address]').length >= 100, null, {
+    timeout: 180_000,
+    polling: 500,
+  });
+  await shot(page, 'street-picture-long');
+  // Measured at once: the picture is written again as lamps are found.
+  const seen = await page.evaluate(() => {
+    const svg = document.querySelector('#street-picture svg.pk').getBoundingClientRect();
+    return {
+      top: svg.top,
+      height: svg.height,
+      lamps: document.querySelectorAll('#street-picture g[data-address]').length,
+      names: document.querySelectorAll('#street-picture text.pk-name').length,
+      title: document.querySelector('#street-picture g[data-address] title').textContent,
+    };
+  });
+  assert.equal(seen.names, 0, 'no words under small marks');
+  const rows = Math.ceil(seen.lamps / 58);
+  assert.ok(Math.abs(seen.height - rows * 26) <= 2 * rows, `${rows} rows of 26 px: ${seen.height} px`);
+  // 500 lamps take 9 rows: the picture would still end within the window.
+  assert.ok(seen.top + (9 * seen.height) / rows <= 768, `the picture starts at ${seen.top} px`);
+  assert.match(seen.title, /^0080e1[0-9a-f]{6}: /);
+});
