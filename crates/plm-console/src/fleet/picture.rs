@@ -125,7 +125,7 @@ pub fn html(fleet: &BTreeMap<Address, Lamp>, poles: Option<&[Pole]>) -> String {
     }
     let named = places.len() <= NAMED_MAX;
     // Cell size, left margin (row numbers when small), marks to a row.
-    let (w, h, left) = if named { (110, 76, 0) } else { (22, 26, 34) };
+    let (w, h, left) = if named { (110, 80, 0) } else { (22, 26, 34) };
     let per_row = ((WIDTH - left) / w) as usize;
     let rows = places.len().div_ceil(per_row);
     let height = rows as i32 * h;
@@ -192,7 +192,7 @@ fn lamp(p: &Place, x: i32, y: i32, cy: i32, w: i32, named: bool) -> String {
         "<g class=\"pk-lamp\"{address} data-look=\"{}\"><title>{}</title><rect class=\"pk-hit\" x=\"{x}\" y=\"{y}\" width=\"{w}\" height=\"{}\"/>",
         look_key(look),
         esc(&title),
-        if named { 76 } else { 26 }
+        if named { 80 } else { 26 }
     );
     let r = match (named, look.in_trouble()) {
         (true, true) => 11,
@@ -229,21 +229,21 @@ fn lamp(p: &Place, x: i32, y: i32, cy: i32, w: i32, named: bool) -> String {
         };
         g.push_str(&format!(
             "<text class=\"pk-name\" x=\"{cx}\" y=\"{}\">{}</text>",
-            y + 50,
+            y + 48,
             esc(&short)
         ));
         if let Some(d) = dimming {
             g.push_str(&format!(
                 "<text class=\"pk-small\" x=\"{cx}\" y=\"{}\">dim set {d} %</text>",
-                y + 62
+                y + 61
             ));
         }
-        g.push_str(&bar(y + 67, 50));
+        g.push_str(&bar(y + 69, 50));
         if let Some(s) = snr {
             g.push_str(&format!(
                 "<text class=\"pk-small pk-db\" x=\"{}\" y=\"{}\">{s} dB</text>",
                 cx + 14,
-                y + 71
+                y + 73
             ));
         }
     } else {
@@ -353,7 +353,7 @@ mod tests {
             (1..=12).map(|i| a(i).to_string()).collect::<Vec<_>>()
         );
         // Twelve named lamps in one row, each with its SNR bar (20 of 30 dB).
-        assert!(html.contains("viewBox=\"0 0 1320 76\""), "{html}");
+        assert!(html.contains("viewBox=\"0 0 1320 80\""), "{html}");
         assert_eq!(html.matches("class=\"pk-snr\"").count(), 12);
         assert!(html.contains("width=\"33\" height=\"3\""));
         assert_eq!(html.matches(">20 dB</text>").count(), 12);
