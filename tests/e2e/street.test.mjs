@@ -187,10 +187,10 @@ test('dim one lamp and see its power follow; dim all by broadcast', async (t) =>
   await page.fill('#lamp-dim-level', '');
   await page.focus('#lamp-dim-level');
   await page.keyboard.type('2');
-  const state = await page.locator('#lamp-panel figure.spark polyline').first().getAttribute('points');
+  const state = await page.locator('#plot-power path.plot-line').getAttribute('d');
   await page.evaluate(() => document.querySelector('#lamp-read').click());
   await page.locator('#lamp-note', { hasText: 'read: done' }).waitFor({ timeout: 30_000 });
-  await page.waitForFunction((was) => document.querySelector('#lamp-panel figure.spark polyline').getAttribute('points') !== was, state);
+  await page.waitForFunction((was) => document.querySelector('#plot-power path.plot-line').getAttribute('d') !== was, state);
   await page.keyboard.type('0');
   assert.equal(await page.inputValue('#lamp-dim-level'), '20');
   assert.equal(await page.evaluate(() => document.activeElement.id), 'lamp-dim-level');
