@@ -22,6 +22,7 @@ static ALLOCATOR: talc::wasm::WasmDynamicTalc = talc::wasm::new_wasm_dynamic_all
 pub mod clock;
 pub mod fleet;
 pub mod line_events;
+pub mod long_table;
 pub mod mibform;
 pub mod network;
 pub mod numbers;

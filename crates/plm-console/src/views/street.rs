@@ -8,7 +8,8 @@ mod picture;
 
 use super::files::download;
 use super::widgets::{
-    button, checkbox, closest, live_button, on_click, on_event, signal, text_input,
+    button, checkbox, closest, draw_rows, live_button, on_click, on_event, scrolled, signal,
+    text_input,
 };
 use crate::fleet::{self, Row, COLUMNS};
 use crate::stores::use_console;
@@ -29,9 +30,7 @@ pub fn StreetView() -> impl IntoView {
     // as the page has (docs/console.md, "Size").
     let focus = signal(None::<u64>);
     let message = signal(None::<String>);
-    // The rows shown, sorted and filtered; the table keys its lines by
-    // address and each line follows its own lamp, so a reading redraws one
-    // line and a sort moves lines, without rebuilding the table.
+    // The rows shown, sorted and filtered.
     let rows = Memo::new(move |_| {
         street.version.track();
         let now = street.now.get();
@@ -56,6 +55,26 @@ pub fn StreetView() -> impl IntoView {
             message.set(Some(e));
         }
     };
+    // Where the table is scrolled; only the rows in view are in the page
+    // (`widgets::draw_rows`), each written as HTML, so that 500 lamps lay
+    // out as fast as 30.
+    let top = signal(0u32);
+    Effect::new(move |drawn: Option<String>| {
+        let top = top.get();
+        let focused = focus.get();
+        selected.with(|picked| {
+            rows.with(|all| {
+                let mut html = |w: std::ops::Range<usize>| {
+                    let row = |r: &Row| {
+                        let focus = focused == Some(row_key(r.address));
+                        row_html(r, picked.contains(&r.address), focus)
+                    };
+                    all[w].iter().map(row).collect()
+                };
+                draw_rows("fleet-table", all.len(), top, false, &mut html, drawn)
+            })
+        })
+    });
     view! {
         <div class="street">
             <div class="toolbar">
@@ -78,7 +97,17 @@ pub fn StreetView() -> impl IntoView {
             }).map(IntoAny::into_any)}
             <Alerts focus=focus/>
             <div class="street-grid" class:with-lamp=move || focus.with(|f| f.is_some())>
-                <div class="table-wrap">
+                <div
+                    class="table-wrap"
+                    id="fleet-wrap"
+                    on:scroll=on_event(move |ev| {
+                        if let Some((at, _)) = scrolled(&ev, "#fleet-wrap") {
+                            if top.get_untracked() != at {
+                                top.set(at);
+                            }
+                        }
+                    })
+                >
                     <table class="log fleet" id="fleet-table">
                         <thead>
                             <tr>
@@ -148,31 +177,6 @@ pub fn StreetView() -> impl IntoView {
                                 });
                             })
                         >
-                            {super::widgets::keyed_rows(
-                                move || rows.with(|r| r.iter().map(|r| row_key(r.address)).collect()),
-                                move |key| {
-                                    let address = key_address(key);
-                                    // At most one row, in a memo of the table's own type
-                                    // (a memo type of its own costs the page its code).
-                                    let row = Memo::new(move |_| {
-                                        street.version.track();
-                                        let now = street.now.get();
-                                        street.with_fleet(|f| f.get(&address).map(|l| Row::of(l, now)).into_iter().collect::<Vec<_>>())
-                                    });
-                                    view! {
-                                        <tr
-                                            data-address=address.to_string()
-                                            class:trouble=move || row.with(|r| r.first().is_some_and(|r| r.trouble))
-                                            class:selected=move || focus.get() == Some(key)
-                                            inner_html=move || {
-                                                let picked = selected.with(|s| s.contains(&address));
-                                                row.with(|r| row_html(r.first(), picked))
-                                            }
-                                        ></tr>
-                                    }
-                                    .into_any()
-                                },
-                            )}
                         </tbody>
                     </table>
                     {move || (rows.with(|r| r.is_empty())).then(|| view! {
@@ -342,25 +346,35 @@ fn Alerts(focus: RwSignal<Option<u64>>) -> impl IntoView {
     }
 }
 
-/// A fleet row's cells as HTML: the selection checkbox, then each of
-/// [`COLUMNS`] (`–` where the lamp has no value yet).
-fn row_html(row: Option<&Row>, picked: bool) -> String {
+/// A fleet row as HTML: the lamp's address and marks on the line, the
+/// selection checkbox, then each of [`COLUMNS`] (`–` where the lamp has
+/// no value yet).
+fn row_html(row: &Row, picked: bool, focus: bool) -> String {
+    let class = match (row.trouble, focus) {
+        (true, true) => " class=\"trouble selected\"",
+        (true, false) => " class=\"trouble\"",
+        (false, true) => " class=\"selected\"",
+        (false, false) => "",
+    };
     let mut html = format!(
-        "<td class=\"pick\"><input type=\"checkbox\"{}></td>",
+        "<tr data-address=\"{}\"{class}><td class=\"pick\"><input type=\"checkbox\"{}></td>",
+        row.address,
         if picked { " checked" } else { "" }
     );
     for (key, _) in COLUMNS {
         let class = match *key {
-            "state" => row.map_or("", |r| r.look.class()),
+            "state" => row.look.class(),
             "address" | "firmware" => "hex",
             _ => "num",
         };
-        let cell = row.map(|r| r.cell(key)).filter(|c| !c.is_empty());
+        let cell = row.cell(key);
+        let cell = if cell.is_empty() { "–" } else { &cell };
         html.push_str(&format!(
             "<td class=\"{class}\" data-key=\"{key}\">{}</td>",
-            super::widgets::escape(cell.as_deref().unwrap_or("–"))
+            super::widgets::escape(cell)
         ));
     }
+    html.push_str("</tr>");
     html
 }
 

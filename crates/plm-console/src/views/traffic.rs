@@ -2,11 +2,13 @@
 //! by plm-core, with hex, filters, pause, clear, export and import.
 
 use super::files;
-use super::widgets::{button, closest, escape, on_click, on_event, option_html, signal};
+use super::widgets::{
+    button, closest, draw_rows, escape, on_click, on_event, option_html, scrolled, signal,
+};
 use super::{seconds, spaced};
 use crate::stores::use_console;
 use crate::tab::Tab;
-use crate::traffic::{Entry, Filter, CAPACITY, ROW_PX};
+use crate::traffic::{Entry, Filter, CAPACITY};
 use leptos::prelude::*;
 use std::sync::Arc;
 
@@ -52,41 +54,16 @@ pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
     // (scrolled to the bottom, as it opens).
     let top = signal(0u32);
     let follow = signal(true);
-    // Only the rows in view are in the page ([`crate::traffic::window`]),
-    // written as HTML; the table's margins keep the room of the others, so
-    // that the scroll bar is the whole log's.
+    // Only the rows in view are in the page (`widgets::draw_rows`).
     Effect::new(move |drawn: Option<String>| {
         let follow = follow.get();
         let top = if follow { 0 } else { top.get() };
         let chosen = selected.get();
-        // The table's height at most (style.css `.table-wrap`: 100vh - 190px).
-        let page_px = window().inner_height().ok().and_then(|h| h.as_f64());
-        let view_px = (page_px.unwrap_or(900.0) - 190.0).max(220.0) as u32;
-        let (html, above, below) = rows.with(|(_, all)| {
-            let w = crate::traffic::window(all.len(), top, view_px, follow);
-            let html: String = all[w.clone()].iter().map(|e| row_html(e, chosen)).collect();
-            (html, w.start, all.len() - w.end)
+        let drawn = rows.with(|(_, all)| {
+            let mut html =
+                |w: std::ops::Range<usize>| all[w].iter().map(|e| row_html(e, chosen)).collect();
+            draw_rows("traffic-table", all.len(), top, follow, &mut html, drawn)
         });
-        // What the body holds: written only when it changes.
-        let mut drawn = drawn.unwrap_or_default();
-        let doc = document();
-        if let (Some(table), Ok(Some(body))) = (
-            doc.get_element_by_id("traffic-table"),
-            doc.query_selector("#traffic-table tbody"),
-        ) {
-            let _ = table.set_attribute(
-                "style",
-                &format!(
-                    "margin: {}px 0 {}px",
-                    above as u32 * ROW_PX,
-                    below as u32 * ROW_PX
-                ),
-            );
-            if drawn != html {
-                body.set_inner_html(&html);
-                drawn = html;
-            }
-        }
         if follow {
             request_animation_frame(|| {
                 if let Some(wrap) = document().get_element_by_id("traffic-wrap") {
@@ -139,14 +116,9 @@ pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
                 class="table-wrap"
                 id="traffic-wrap"
                 on:scroll=on_event(move |ev| {
-                    let Some(wrap) = closest(&ev, "#traffic-wrap") else {
+                    let Some((at, bottom)) = scrolled(&ev, "#traffic-wrap") else {
                         return;
                     };
-                    // web-sys has scrollTop as an f64 for wasm32, an i32 natively.
-                    #[allow(clippy::useless_conversion)]
-                    let at = f64::from(wrap.scroll_top()).max(0.0) as u32;
-                    let bottom = at as i32 + wrap.client_height() + ROW_PX as i32 / 2
-                        >= wrap.scroll_height();
                     let was = top.get_untracked();
                     if was != at {
                         top.set(at);

@@ -4,7 +4,6 @@
 //! docs/console.md "Size").
 
 use leptos::prelude::*;
-use std::sync::Arc;
 
 /// A button labelled `label`; `id` and `title` (a tooltip) may be empty.
 pub fn button(
@@ -133,26 +132,6 @@ pub fn text_table(
     .into_any()
 }
 
-/// A keyed list (Leptos's `<For>`) of rows named by a number: `each` gives
-/// the keys in order, `row` makes the row of a new key; a row stays as long
-/// as its key does. One instance of `<For>` and its keyed diff for every
-/// such list (the Street table, the Traffic log) rather than one per item
-/// and row type, each about 6 KB of code.
-pub fn keyed_rows(
-    each: impl Fn() -> Vec<u64> + Send + Sync + 'static,
-    row: impl Fn(u64) -> AnyView + Send + Sync + 'static,
-) -> AnyView {
-    keyed_rows_boxed(Box::new(each), Arc::new(row))
-}
-
-type Keys = Box<dyn Fn() -> Vec<u64> + Send + Sync>;
-type MakeRow = Arc<dyn Fn(u64) -> AnyView + Send + Sync>;
-
-#[inline(never)]
-fn keyed_rows_boxed(each: Keys, row: MakeRow) -> AnyView {
-    view! { <For each=move || each() key=|k: &u64| *k children=move |k| row(k)/> }.into_any()
-}
-
 /// A `change` or `input` handler, boxed: tachys's event code is generic
 /// over the handler's type, so every `on:change=on_event(..)` of the page
 /// shares one instance of it instead of one per closure.
@@ -278,4 +257,54 @@ pub fn closest(ev: &web_sys::Event, selector: &str) -> Option<web_sys::Element> 
         .ok()?
         .closest(selector)
         .ok()?
+}
+
+/// Draws the rows of the long table `table_id` that are in view
+/// ([`crate::long_table::window`] of `total` rows, scrolled to `top_px`
+/// or following the newest): `rows` writes them as HTML into its body,
+/// and the table's margins keep the room of the others. `drawn` is what
+/// the body held (it is written only when that changes); returns what it
+/// holds now. The table's `data-rows` says how many rows it has in all.
+pub fn draw_rows(
+    table_id: &str,
+    total: usize,
+    top_px: u32,
+    follow: bool,
+    rows: &mut dyn FnMut(std::ops::Range<usize>) -> String,
+    drawn: Option<String>,
+) -> String {
+    use crate::long_table::ROW_PX;
+    // The table's height at most (style.css `.table-wrap`: 100vh - 190px).
+    let page_px = window().inner_height().ok().and_then(|h| h.as_f64());
+    let view_px = (page_px.unwrap_or(900.0) - 190.0).max(220.0) as u32;
+    let w = crate::long_table::window(total, top_px, view_px, follow);
+    let (above, below) = (w.start as u32, (total - w.end) as u32);
+    let html = rows(w);
+    let mut drawn = drawn.unwrap_or_default();
+    let doc = document();
+    if let (Some(table), Ok(Some(body))) = (
+        doc.get_element_by_id(table_id),
+        doc.query_selector(&format!("#{table_id} tbody")),
+    ) {
+        let margin = format!("margin: {}px 0 {}px", above * ROW_PX, below * ROW_PX);
+        let _ = table.set_attribute("style", &margin);
+        let _ = table.set_attribute("data-rows", &total.to_string());
+        if drawn != html {
+            body.set_inner_html(&html);
+            drawn = html;
+        }
+    }
+    drawn
+}
+
+/// Where the scrolling box of a long table (`wrap`, a selector) that `ev`
+/// happened in is scrolled (CSS px), and whether to its end.
+pub fn scrolled(ev: &web_sys::Event, wrap: &str) -> Option<(u32, bool)> {
+    let wrap = closest(ev, wrap)?;
+    // web-sys has scrollTop as an f64 for wasm32, an i32 natively.
+    #[allow(clippy::useless_conversion)]
+    let at = f64::from(wrap.scroll_top()).max(0.0) as u32;
+    let half_row = crate::long_table::ROW_PX as i32 / 2;
+    let end = at as i32 + wrap.client_height() + half_row >= wrap.scroll_height();
+    Some((at, end))
 }
