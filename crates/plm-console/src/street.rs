@@ -78,11 +78,6 @@ impl Lamp {
     pub fn state(&self) -> Option<LampState> {
         self.ballast.map(|b| b.state())
     }
-
-    /// Whether it needs a technician's eye: failed or unreachable.
-    pub fn in_trouble(&self) -> bool {
-        crate::fleet::Look::of(self).in_trouble()
-    }
 }
 
 /// Something a technician must see.
@@ -823,6 +818,7 @@ impl StreetSession {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fleet::Look;
     use crate::transport::sim::SimTransport;
     use crate::transport::LampAction;
     use plm_core::st7580::TxParams;
@@ -944,9 +940,9 @@ mod tests {
                 about(8).any(|a| a.what.starts_with("stopped answering")),
                 "{via:?}: {alerts:?}"
             );
-            assert!(s.fleet()[&street_address(5)].in_trouble());
-            assert!(s.fleet()[&street_address(8)].in_trouble());
-            assert!(!s.fleet()[&street_address(6)].in_trouble());
+            assert!(Look::of(&s.fleet()[&street_address(5)]).in_trouble());
+            assert!(Look::of(&s.fleet()[&street_address(8)]).in_trouble());
+            assert!(!Look::of(&s.fleet()[&street_address(6)]).in_trouble());
         }
     }
 

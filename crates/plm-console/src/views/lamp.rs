@@ -205,7 +205,7 @@ fn state_html(lamp: Option<&Lamp>, simulated: bool) -> String {
     };
     let mut html = format!(
         "<p{}>{}</p>",
-        if l.in_trouble() {
+        if crate::fleet::Look::of(l).in_trouble() {
             " class=\"problem\""
         } else {
             ""
