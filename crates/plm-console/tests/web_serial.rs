@@ -12,8 +12,8 @@ mod browser;
 
 use browser::{sleep, Driven, Exclusive};
 use js_sys::{Array, Function, Promise, Reflect, Uint8Array};
+use plm_console::clock::page_now_us;
 use plm_console::session::{Outcome, Session};
-use plm_console::stores::page_now_us;
 use plm_console::transport::webserial::{self, OnLost, Settings, TReqPolarity, WebSerialTransport};
 use plm_console::transport::{LinkState, Transport};
 use plm_core::st7580::Command;

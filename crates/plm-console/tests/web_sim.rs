@@ -29,10 +29,10 @@ fn simulated(nodes: usize) -> Driven {
 async fn the_modem_boots_and_answers_ping_and_mib_reads_in_real_time() {
     let _page = Exclusive::take().await;
     let mut d = simulated(1);
-    let start = plm_console::stores::page_now_us();
+    let start = plm_console::clock::page_now_us();
     // UM0932 4.2.9: the modem announces its power-on reset.
     d.booted(1_000.0).await;
-    let elapsed_ms = (plm_console::stores::page_now_us() - start) / 1_000.0;
+    let elapsed_ms = (plm_console::clock::page_now_us() - start) / 1_000.0;
     // The simulated modem boots in 20 ms of virtual time, which follows
     // the page's clock: not instantly, and not seconds late.
     assert!(

@@ -349,7 +349,10 @@ pub fn follow(pick: Pick) -> Box<dyn FnMut(web_sys::MouseEvent)> {
         if r.width() <= 0.0 {
             return;
         }
-        let share = (f64::from(ev.client_x()) - r.left()) / r.width();
+        // web-sys has clientX as an f64 for wasm32, an i32 natively.
+        #[allow(clippy::useless_conversion)]
+        let x = f64::from(ev.client_x());
+        let share = (x - r.left()) / r.width();
         if let (Some(h), Some(g)) = (pick(&svg.id(), share), svg.last_element_child()) {
             g.set_inner_html(&h);
         }

@@ -3,8 +3,8 @@
 //! transports run exactly as in the page, in real time.
 
 use js_sys::Promise;
+use plm_console::clock::page_now_us;
 use plm_console::session::{Budget, Note, Outcome, Session};
-use plm_console::stores::page_now_us;
 use plm_core::st7580::Command;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
