@@ -4,6 +4,7 @@
 // needs (see /work/.library/env: no background networking).
 
 import assert from 'node:assert/strict';
+import { before, after } from 'node:test';
 import http from 'node:http';
 import fs from 'node:fs/promises';
 import path from 'node:path';
@@ -108,4 +109,22 @@ export async function watchedPage(t, context) {
     assert.deepEqual(errors, [], 'no errors in the page');
   });
   return page;
+}
+
+/**
+ * A test file's console and browser: dist/ served and Chromium started
+ * before its tests, both closed after them. `suite.base` is the page's
+ * address, `suite.browser` the browser.
+ */
+export function browserSuite() {
+  const suite = { server: null, base: null, browser: null };
+  before(async () => {
+    ({ server: suite.server, base: suite.base } = await serveDist());
+    suite.browser = await launchChromium();
+  });
+  after(async () => {
+    await suite.browser?.close();
+    await new Promise((r) => (suite.server ? suite.server.close(r) : r()));
+  });
+  return suite;
 }

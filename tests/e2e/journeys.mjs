@@ -7,6 +7,9 @@ import fs from 'node:fs/promises';
 import path from 'node:path';
 import { artifacts } from './harness.mjs';
 
+/** The address of the simulated street's lamp `n` (plm_sim's street_address). */
+export const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
+
 /** Opens a view by its tab. */
 export async function tab(page, slug) {
   await page.click(`#tab-${slug}`);

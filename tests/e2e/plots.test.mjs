@@ -5,34 +5,21 @@
 // record of them forgotten in words. At the laptop size a field
 // technician has (1366 × 768).
 
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot, tab } from './journeys.mjs';
+import { browserSuite, watchedPage } from './harness.mjs';
+import { lamp, shot, tab } from './journeys.mjs';
 
-let server;
-let base;
-let browser;
-
-before(async () => {
-  ({ server, base } = await serveDist());
-  browser = await launchChromium();
-});
-
-after(async () => {
-  await browser?.close();
-  await new Promise((r) => (server ? server.close(r) : r()));
-});
+const suite = browserSuite();
 
 const LAMPS = 12;
-const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
 const CLOCK = /^\d\d:\d\d(:\d\d)?$/;
 
 async function open(t, query = '', init = null) {
-  const context = await browser.newContext({ viewport: { width: 1366, height: 768 } });
+  const context = await suite.browser.newContext({ viewport: { width: 1366, height: 768 } });
   const page = await watchedPage(t, context);
   if (init) await page.addInitScript(init);
-  await page.goto(base + query);
+  await page.goto(suite.base + query);
   return page;
 }
 

@@ -7,29 +7,16 @@
 // as an alert, the others burn on, the far lamp still answers, and the
 // mains have moved.
 
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
-import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot } from './journeys.mjs';
+import { browserSuite, watchedPage } from './harness.mjs';
+import { lamp, shot } from './journeys.mjs';
 
-let server;
-let base;
-let browser;
-
-before(async () => {
-  ({ server, base } = await serveDist());
-  browser = await launchChromium();
-});
-
-after(async () => {
-  await browser?.close();
-  await new Promise((r) => (server ? server.close(r) : r()));
-});
+const suite = browserSuite();
 
 const LAMPS = 12;
 const SPEED = 10;
-const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
 
 /** The street's clock, s of simulated time. */
 const streetSeconds = (page) => page.evaluate(() => window.plmBench.streetSeconds());
@@ -58,9 +45,9 @@ async function fleet(page) {
 const distinct = (rows, key) => new Set(Object.values(rows).map((r) => r[key])).size;
 
 test('the demo street at 15 s and at 180 s: lamps that differ, a worn one failing, a weak one answering', async (t) => {
-  const context = await browser.newContext({ acceptDownloads: true, viewport: { width: 1366, height: 768 } });
+  const context = await suite.browser.newContext({ acceptDownloads: true, viewport: { width: 1366, height: 768 } });
   const page = await watchedPage(t, context);
-  await page.goto(base + `?speed=${SPEED}`);
+  await page.goto(suite.base + `?speed=${SPEED}`);
   await page.locator('#view-street').waitFor({ state: 'visible' });
 
   await until(page, 15);

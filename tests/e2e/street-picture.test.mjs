@@ -4,27 +4,14 @@
 // pole list imported (the order follows it, and is kept), a malformed
 // one refused in words with nothing changed.
 
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot } from './journeys.mjs';
+import { browserSuite, watchedPage } from './harness.mjs';
+import { lamp, shot } from './journeys.mjs';
 
-let server;
-let base;
-let browser;
-
-before(async () => {
-  ({ server, base } = await serveDist());
-  browser = await launchChromium();
-});
-
-after(async () => {
-  await browser?.close();
-  await new Promise((r) => (server ? server.close(r) : r()));
-});
+const suite = browserSuite();
 
 const LAMPS = 12;
-const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
 const mark = (page, n) => page.locator(`#street-picture g[data-address="${lamp(n)}"]`);
 /** The lamps of the picture, in its order. */
 const order = (page) =>
@@ -32,9 +19,9 @@ const order = (page) =>
 
 /** A fresh page at 1366×768, once every lamp of the picture was read. */
 async function open(t, query = '') {
-  const context = await browser.newContext({ viewport: { width: 1366, height: 768 } });
+  const context = await suite.browser.newContext({ viewport: { width: 1366, height: 768 } });
   const page = await watchedPage(t, context);
-  await page.goto(base + query);
+  await page.goto(suite.base + query);
   await page.locator('#view-street').waitFor({ state: 'visible' });
   await page.waitForFunction(
     (n) => {
@@ -143,9 +130,9 @@ test('a pole list orders the picture and is kept; a malformed one is refused wit
 });
 
 test('a long street: small marks in rows that wrap, the picture in view', async (t) => {
-  const context = await browser.newContext({ viewport: { width: 1366, height: 768 } });
+  const context = await suite.browser.newContext({ viewport: { width: 1366, height: 768 } });
   const page = await watchedPage(t, context);
-  await page.goto(`${base}?lamps=500`);
+  await page.goto(`${suite.base}?lamps=500`);
   // Lamps appear as discovery hears them; a hundred are enough to see the layout.
   await page.waitForFunction(() => document.querySelectorAll('#street-picture g[data-address]').length >= 100, null, {
     timeout: 180_000,

@@ -1,28 +1,15 @@
 // Browser end-to-end journeys of the Street view against the simulated
 // street the page opens on (12 lamps behind a concentrator board's USART).
 
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
-import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot, tab } from './journeys.mjs';
+import { browserSuite, watchedPage } from './harness.mjs';
+import { lamp, shot, tab } from './journeys.mjs';
 
-let server;
-let base;
-let browser;
-
-before(async () => {
-  ({ server, base } = await serveDist());
-  browser = await launchChromium();
-});
-
-after(async () => {
-  await browser?.close();
-  await new Promise((r) => (server ? server.close(r) : r()));
-});
+const suite = browserSuite();
 
 const LAMPS = 12;
-const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
 const row = (page, n) => page.locator(`#fleet-table tbody tr[data-address="${lamp(n)}"]`);
 const cell = (page, n, key) => row(page, n).locator(`td[data-key="${key}"]`);
 const number = async (page, n, key) => Number(await cell(page, n, key).textContent());
@@ -66,13 +53,13 @@ const recordStreet = () => {
  * the same 150 W lamp, nothing failing unless asked).
  */
 async function open(t, meanwhile = async () => {}, query = '') {
-  const context = await browser.newContext({
+  const context = await suite.browser.newContext({
     acceptDownloads: true,
     viewport: { width: 1400, height: 900 },
   });
   const page = await watchedPage(t, context);
   await page.addInitScript(recordStreet);
-  await page.goto(base + query);
+  await page.goto(suite.base + query);
   await page.locator('#view-street').waitFor({ state: 'visible' });
   await meanwhile(page);
   await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
