@@ -458,17 +458,20 @@ mod tests {
         assert_eq!(clock_label(-1.0, 1.0), "23:59:59");
     }
 
+    /// A plot area of 80 × 40 in a 100 × 50 frame, its ends 5 inside.
+    const FRAME: Frame = Frame {
+        width: 100.0,
+        height: 50.0,
+        left: 10.0,
+        right: 90.0,
+        top: 5.0,
+        bottom: 45.0,
+        inset: 5.0,
+    };
+
     #[test]
     fn the_ends_of_an_axis_are_the_plot_area_less_its_inset() {
-        let f = Frame {
-            width: 100.0,
-            height: 50.0,
-            left: 10.0,
-            right: 90.0,
-            top: 5.0,
-            bottom: 45.0,
-            inset: 5.0,
-        };
+        let f = FRAME;
         let a = nice_axis(0.0, 10.0, &WHOLE, 5.0);
         assert_eq!(
             (f.x(&a, 0.0), f.x(&a, 10.0), f.x(&a, 5.0)),
@@ -491,15 +494,7 @@ mod tests {
 
     #[test]
     fn the_cursor_is_a_rule_a_dot_and_the_reading_on_the_side_with_room() {
-        let f = Frame {
-            width: 100.0,
-            height: 50.0,
-            left: 10.0,
-            right: 90.0,
-            top: 5.0,
-            bottom: 45.0,
-            inset: 5.0,
-        };
+        let f = FRAME;
         let left = cursor(&f, 20.0, 30.0, "12:03:05 · 150 W");
         assert!(
             left.contains("x1=\"20.0\" y1=\"5.0\" x2=\"20.0\" y2=\"45.0\""),
