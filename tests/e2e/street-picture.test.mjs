@@ -48,7 +48,7 @@ test('the street picture on opening: every lamp in address order, said so, above
   assert.match(await page.textContent('#street-order'), /^Address order \(no pole list\)/);
   // Each lamp named under its mark, with its SNR bar; the legend counts.
   assert.equal(await page.locator('#street-picture text.pk-name').count(), LAMPS);
-  assert.equal(await page.locator('#street-picture rect.pk-snr').count(), LAMPS);
+  assert.equal(await page.locator('#street-picture .pk-snr').count(), LAMPS);
   assert.match(await page.textContent('#street-picture .pk-legend'), /dim set: as last set from this console/);
   assert.ok(await inView(page, page.locator('#street-picture svg.pk')), 'the picture is in view as the page opens');
   const picture = await page.locator('#street-picture svg.pk').boundingBox();
@@ -67,9 +67,9 @@ test('a failed lamp and a silent one stand out in the picture; a click opens a l
   await page.locator(`#street-picture g[data-address="${lamp(5)}"][data-look="failed"]`).waitFor({ timeout: 60_000 });
   await page.locator(`#street-picture g[data-address="${lamp(9)}"][data-look="silent"]`).waitFor({ timeout: 60_000 });
   // A ring around each, none around the others; named above the picture.
-  assert.equal(await mark(page, 5).locator('circle.pk-halo').count(), 1);
-  assert.equal(await mark(page, 9).locator('circle.pk-halo').count(), 1);
-  assert.equal(await page.locator('#street-picture circle.pk-halo').count(), 2);
+  assert.equal(await mark(page, 5).locator('.pk-halo').count(), 1);
+  assert.equal(await mark(page, 9).locator('.pk-halo').count(), 1);
+  assert.equal(await page.locator('#street-picture .pk-halo').count(), 2);
   assert.match(await page.textContent('#street-trouble'), new RegExp(`${lamp(5)} failed`));
   assert.match(await page.textContent('#street-trouble'), new RegExp(`${lamp(9)} not answering`));
   assert.ok(await inView(page, mark(page, 5)), 'the failed lamp is in view without scrolling');
@@ -80,6 +80,9 @@ test('a failed lamp and a silent one stand out in the picture; a click opens a l
   await page.locator('#lamp-panel h3', { hasText: lamp(5) }).waitFor();
   await mark(page, 7).click();
   await page.locator('#lamp-panel h3', { hasText: lamp(7) }).waitFor();
+  // The picture marks the lamp whose page is open, and only that one.
+  await page.locator(`#street-picture g.pk-focus[data-address="${lamp(7)}"]`).waitFor();
+  assert.equal(await page.locator('#street-picture .pk-focus').count(), 1);
   await shot(page, 'street-picture-lamp');
 });
 
@@ -129,31 +132,47 @@ test('a pole list orders the picture and is kept; a malformed one is refused wit
   assert.equal(await page.evaluate(() => localStorage.getItem('plm-console.poles')), null);
 });
 
-test('a long street: small marks in rows that wrap, the picture in view', async (t) => {
+test('a long street: small marks in rows that wrap, the picture in view, a lamp found by the pointer', async (t) => {
   const context = await suite.browser.newContext({ viewport: { width: 1366, height: 768 } });
   const page = await watchedPage(t, context);
   await page.goto(`${suite.base}?lamps=500`);
   // Lamps appear as discovery hears them; a hundred are enough to see the layout.
-  await page.waitForFunction(() => document.querySelectorAll('#street-picture g[data-address]').length >= 100, null, {
+  await page.waitForFunction(() => Number(document.querySelector('#fleet-table')?.dataset.rows ?? 0) >= 100, null, {
     timeout: 180_000,
     polling: 500,
   });
   await shot(page, 'street-picture-long');
   // Measured at once: the picture is written again as lamps are found.
   const seen = await page.evaluate(() => {
-    const svg = document.querySelector('#street-picture svg.pk').getBoundingClientRect();
+    const svg = document.querySelector('#street-picture svg.pk');
+    const box = svg.getBoundingClientRect();
     return {
-      top: svg.top,
-      height: svg.height,
-      lamps: document.querySelectorAll('#street-picture g[data-address]').length,
+      top: box.top,
+      left: box.left,
+      width: box.width,
+      height: box.height,
+      lamps: Number(document.querySelector('#fleet-table').dataset.rows),
       names: document.querySelectorAll('#street-picture text.pk-name').length,
-      title: document.querySelector('#street-picture g[data-address] title').textContent,
+      // Small marks are a few paths for the whole street, no element per lamp.
+      elements: svg.querySelectorAll('*').length,
     };
   });
   assert.equal(seen.names, 0, 'no words under small marks');
+  assert.ok(seen.elements < 40, `${seen.elements} elements for ${seen.lamps} lamps`);
   const rows = Math.ceil(seen.lamps / 58);
-  assert.ok(Math.abs(seen.height - rows * 26) <= 2 * rows, `${rows} rows of 26 px: ${seen.height} px`);
+  assert.ok(Math.abs(seen.height - rows * 26) <= 2 * rows + 26, `${rows} rows of 26 px: ${seen.height} px`);
   // 500 lamps take 9 rows: the picture would still end within the window.
-  assert.ok(seen.top + (9 * seen.height) / rows <= 768, `the picture starts at ${seen.top} px`);
-  assert.match(seen.title, /^0080e1[0-9a-f]{6}: /);
+  assert.ok(seen.top + (9 * 26 * seen.width) / 1320 <= 768, `the picture starts at ${seen.top} px`);
+  // The first lamp's cell (after the row numbers' 34 px), under the pointer:
+  // its words as the tooltip, a click opens its page and marks its cell.
+  const scale = seen.width / 1320;
+  await page.mouse.move(seen.left + (34 + 11) * scale, seen.top + 9 * scale);
+  const title = await page.getAttribute('#street-picture-street', 'title');
+  assert.match(title, /^0080e1[0-9a-f]{6}: /);
+  await page.mouse.click(seen.left + (34 + 11) * scale, seen.top + 9 * scale);
+  await page.locator('#lamp-panel h3', { hasText: title.slice(0, 12) }).waitFor();
+  await page.locator('#street-picture rect.pk-focus').waitFor();
+  // Over the row numbers' margin, no lamp.
+  await page.mouse.move(seen.left + 5 * scale, seen.top + 9 * scale);
+  assert.equal(await page.getAttribute('#street-picture-street', 'title'), null);
 });

@@ -112,7 +112,7 @@ pub fn App() -> impl IntoView {
                     <StreetView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Update>
-                    <UpdateView/>
+                    <UpdateView tab=tab/>
                 </Panel>
                 <Panel tab=tab which=Tab::Traffic>
                     <TrafficView tab=tab/>

@@ -21,7 +21,7 @@ use std::collections::BTreeMap;
 /// The most lamps drawn with their words under them.
 pub const NAMED_MAX: usize = 36;
 /// The picture's width, in CSS pixels at its natural size.
-const WIDTH: i32 = 1320;
+pub const WIDTH: i32 = 1320;
 /// SNR drawn as a full bar, dB.
 const SNR_FULL: i32 = 30;
 
@@ -63,8 +63,91 @@ fn places<'a>(fleet: &'a BTreeMap<Address, Lamp>, poles: &'a [Pole]) -> Vec<Plac
     listed.chain(rest).collect()
 }
 
-/// The picture of `fleet` in the order of `poles` (none: address order).
-pub fn html(fleet: &BTreeMap<Address, Lamp>, poles: Option<&[Pole]>) -> String {
+/// The picture in parts, so that a change to a few lamps is drawn as
+/// those lamps' marks alone: its heading and legend, the street's size
+/// (an SVG `viewBox`, empty without lamps), the rows' cables and numbers,
+/// and each lamp's mark in the street's order.
+#[derive(Default, PartialEq)]
+pub struct Picture {
+    pub head: String,
+    pub view_box: String,
+    pub rows: String,
+    pub marks: Vec<Mark>,
+    pub grid: Grid,
+}
+
+/// Where the small marks' cells are (more than [`NAMED_MAX`] lamps, drawn
+/// with the rows, no element per lamp), and each cell's lamp and words.
+#[derive(Default, PartialEq)]
+pub struct Grid {
+    pub left: i32,
+    pub w: i32,
+    pub h: i32,
+    pub per_row: usize,
+    pub cells: Vec<Cell>,
+}
+
+/// A small mark's lamp (none when not heard on the line) and tooltip.
+#[derive(PartialEq)]
+pub struct Cell {
+    pub address: Option<Address>,
+    pub title: String,
+}
+
+impl Grid {
+    /// The cell at `x`, `y` of the picture's coordinates (its `viewBox`).
+    pub fn at(&self, x: f64, y: f64) -> Option<&Cell> {
+        let col = (x - f64::from(self.left)) / f64::from(self.w);
+        let row = y / f64::from(self.h);
+        if self.w == 0 || col < 0.0 || row < 0.0 || col >= self.per_row as f64 {
+            return None;
+        }
+        self.cells.get(row as usize * self.per_row + col as usize)
+    }
+}
+
+/// One lamp's mark: drawn in its own cell's coordinates (`body`, an SVG
+/// group's attributes after its `transform` and its content), moved to
+/// its cell by `at` (`translate(x y)`), so that a lamp found earlier in
+/// the street's order moves the marks after it without writing them again.
+#[derive(PartialEq)]
+pub struct Mark {
+    pub address: Address,
+    pub at: String,
+    pub body: String,
+}
+
+impl Mark {
+    pub fn html(&self) -> String {
+        format!("<g transform=\"{}\"{}", self.at, self.body)
+    }
+}
+
+impl Picture {
+    /// The street's SVG (empty without lamps): its rows, then its marks.
+    pub fn street(&self) -> String {
+        if self.view_box.is_empty() {
+            return String::new();
+        }
+        let mut svg = format!(
+            "<svg class=\"pk\" viewBox=\"{}\" role=\"img\" aria-label=\"the street\"><g class=\"pk-rows\">{}</g><g class=\"pk-marks\">",
+            self.view_box, self.rows
+        );
+        for m in &self.marks {
+            svg.push_str(&m.html());
+        }
+        svg.push_str("</g></svg>");
+        svg
+    }
+}
+
+/// The picture of `fleet` in the order of `poles` (none: address order),
+/// the lamp whose page is open (`focus`) marked.
+pub fn picture(
+    fleet: &BTreeMap<Address, Lamp>,
+    poles: Option<&[Pole]>,
+    focus: Option<Address>,
+) -> Picture {
     let places = places(fleet, poles.unwrap_or_default());
     let mut counts = [0usize; Look::ALL.len()];
     for p in &places {
@@ -120,51 +203,205 @@ pub fn html(fleet: &BTreeMap<Address, Lamp>, poles: Option<&[Pole]>) -> String {
     out.push_str(
         "<span>bar: SNR, 0 to 30 dB</span><span>dim set: as last set from this console (the board has no dimming read)</span></div>",
     );
+    let mut picture = Picture {
+        head: out,
+        ..Picture::default()
+    };
     if places.is_empty() {
-        return out;
+        return picture;
     }
     let named = places.len() <= NAMED_MAX;
     // Cell size, left margin (row numbers when small), marks to a row.
     let (w, h, left) = if named { (110, 80, 0) } else { (22, 26, 34) };
     let per_row = ((WIDTH - left) / w) as usize;
     let rows = places.len().div_ceil(per_row);
-    let height = rows as i32 * h;
-    out.push_str(&format!(
-        "<svg class=\"pk\" viewBox=\"0 0 {WIDTH} {height}\" role=\"img\" aria-label=\"the street\">"
-    ));
+    picture.view_box = format!("0 0 {WIDTH} {}", rows as i32 * h);
+    let cy = if named { 24 } else { 9 };
+    let mut out = String::new();
     for (r, row) in places.chunks(per_row).enumerate() {
         let y = r as i32 * h;
-        let cy = y + if named { 24 } else { 9 };
         let last = left + (row.len() as i32 - 1) * w + w / 2;
         out.push_str(&format!(
-            "<line class=\"pk-cable\" x1=\"{}\" y1=\"{cy}\" x2=\"{last}\" y2=\"{cy}\"/>",
-            left + w / 2
+            "<line class=\"pk-cable\" x1=\"{}\" y1=\"{}\" x2=\"{last}\" y2=\"{}\"/>",
+            left + w / 2,
+            y + cy,
+            y + cy
         ));
         if !named {
             out.push_str(&format!(
                 "<text class=\"pk-small\" x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>",
                 left - 4,
-                cy + 4,
+                y + cy + 4,
                 r * per_row + 1
             ));
         }
-        for (i, place) in row.iter().enumerate() {
-            let x = left + i as i32 * w;
-            out.push_str(&lamp(place, x, y, cy, w, named));
-        }
     }
-    out.push_str("</svg>");
-    out
+    if named {
+        for (i, place) in places.iter().enumerate() {
+            let focused = focus == Some(place.address) && place.lamp.is_some();
+            let (x, y) = (left + (i % per_row) as i32 * w, (i / per_row) as i32 * h);
+            picture.marks.push(Mark {
+                address: place.address,
+                at: format!("translate({x} {y})"),
+                body: lamp(place, cy, w, focused),
+            });
+        }
+    } else {
+        let grid = Grid {
+            left,
+            w,
+            h,
+            per_row,
+            cells: Vec::new(),
+        };
+        out.push_str(&small_marks(&places, &grid, cy, focus));
+        picture.grid = Grid {
+            cells: places
+                .iter()
+                .map(|p| Cell {
+                    address: p.lamp.map(|_| p.address),
+                    title: title(p),
+                })
+                .collect(),
+            ..grid
+        };
+    }
+    picture.rows = out;
+    picture
 }
 
-/// One place's mark, words and SNR bar, in its cell at `x`, `y`.
-fn lamp(p: &Place, x: i32, y: i32, cy: i32, w: i32, named: bool) -> String {
+/// Small marks (more than [`NAMED_MAX`] lamps), drawn as one path per
+/// kind of shape for the whole street rather than elements per lamp: 500
+/// lamps are a dozen elements to lay out and paint, not 2 500. The lamp
+/// under the pointer is found by its cell ([`Grid::at`]).
+fn small_marks(places: &[Place], grid: &Grid, cy: i32, focus: Option<Address>) -> String {
+    // Path data by class, bottom first: the bars, the rings of the lamps
+    // in trouble, then the marks.
+    let mut paths: Vec<(&str, String)> = ["pk-track", "pk-snr", "pk-halo"]
+        .into_iter()
+        .chain(SHAPE_CLASSES)
+        .map(|c| (c, String::new()))
+        .collect();
+    let mut add = |class: &str, d: &str| {
+        if let Some((_, all)) = paths.iter_mut().find(|(c, _)| *c == class) {
+            all.push_str(d);
+        }
+    };
+    let mut svg = String::new();
+    for (i, p) in places.iter().enumerate() {
+        let (x, y) = (
+            grid.left + (i % grid.per_row) as i32 * grid.w,
+            (i / grid.per_row) as i32 * grid.h,
+        );
+        let (cx, cy) = (x + grid.w / 2, y + cy);
+        if focus == Some(p.address) && p.lamp.is_some() {
+            svg.push_str(&format!(
+                "<rect class=\"pk-hit pk-focus\" x=\"{x}\" y=\"{y}\" width=\"{}\" height=\"{}\"/>",
+                grid.w, grid.h
+            ));
+        }
+        let look = p.look();
+        let r = if look.in_trouble() { 8 } else { 6 };
+        let (track, bar) = snr_bar(p.lamp.and_then(|l| l.snr), cx - 8, y + 19, 16);
+        add("pk-track", &track);
+        add("pk-snr", &bar);
+        if look.in_trouble() {
+            add("pk-halo", &circle(cx, cy, halo(r)));
+        }
+        for (class, d) in shapes(look, cx, cy, r) {
+            add(class, &d);
+        }
+    }
+    for (class, d) in paths.iter().filter(|(_, d)| !d.is_empty()) {
+        svg.push_str(&format!("<path class=\"{class}\" d=\"{d}\"/>"));
+    }
+    svg
+}
+
+/// One place's mark, words and SNR bar in a cell `w` wide, its cable at
+/// `cy` (the cell's coordinates: a [`Mark`]'s body); the lamp whose page
+/// is open `focused`.
+fn lamp(p: &Place, cy: i32, w: i32, focused: bool) -> String {
     let look = p.look();
-    let cx = x + w / 2;
+    let cx = w / 2;
     let name = p.name();
     let dimming = p.lamp.and_then(|l| l.dimming);
     let snr = p.lamp.and_then(|l| l.snr);
-    let mut title = name.clone();
+    // A lamp not heard has no page to open.
+    let address = match p.lamp {
+        Some(_) => format!(" data-address=\"{}\"", p.address),
+        None => String::new(),
+    };
+    let mut g = format!(
+        " class=\"pk-lamp{}\"{address} data-look=\"{}\"><title>{}</title><rect class=\"pk-hit\" width=\"{w}\" height=\"80\"/>",
+        if focused { " pk-focus" } else { "" },
+        look_key(look),
+        esc(&title(p)),
+    );
+    let r = if look.in_trouble() { 11 } else { 9 };
+    if look.in_trouble() {
+        g.push_str(&format!(
+            "<path class=\"pk-halo\" d=\"{}\"/>",
+            circle(cx, cy, halo(r))
+        ));
+    }
+    g.push_str(&mark(look, cx, cy, r));
+    if let Some(m) = p.pole.and_then(|p| p.position) {
+        g.push_str(&format!(
+            "<text class=\"pk-small\" x=\"{cx}\" y=\"9\">{m} m</text>"
+        ));
+    }
+    let short: String = if name.chars().count() > 15 {
+        name.chars().take(14).chain(['…']).collect()
+    } else {
+        name
+    };
+    g.push_str(&format!(
+        "<text class=\"pk-name\" x=\"{cx}\" y=\"48\">{}</text>",
+        esc(&short)
+    ));
+    if let Some(d) = dimming {
+        g.push_str(&format!(
+            "<text class=\"pk-small\" x=\"{cx}\" y=\"61\">dim set {d} %</text>"
+        ));
+    }
+    // The bar leaves room for its figure on its right.
+    let (track, bar) = snr_bar(snr, cx - 40, 69, 50);
+    g.push_str(&format!(
+        "<path class=\"pk-track\" d=\"{track}\"/><path class=\"pk-snr\" d=\"{bar}\"/>"
+    ));
+    if let Some(s) = snr {
+        g.push_str(&format!(
+            "<text class=\"pk-small pk-db\" x=\"{}\" y=\"73\">{s} dB</text>",
+            cx + 14
+        ));
+    }
+    g.push_str("</g>");
+    g
+}
+
+/// The radius of the ring around the mark of radius `r` of a lamp in
+/// trouble.
+fn halo(r: i32) -> i32 {
+    r + r / 2 + 2
+}
+
+/// An SNR bar at `x`, `y`, `full` long at [`SNR_FULL`]: its track and its
+/// bar as path data (3 high).
+fn snr_bar(snr: Option<i8>, x: i32, y: i32, full: i32) -> (String, String) {
+    let len = snr.map_or(0, |s| (i32::from(s).clamp(0, SNR_FULL) * full) / SNR_FULL);
+    let bar = |len: i32| format!("M{x} {y}h{len}v3h{}Z", -len);
+    (bar(full), bar(len))
+}
+
+/// What a place's tooltip says: its name, address and position, its look,
+/// the dimming last set and its signal quality.
+fn title(p: &Place) -> String {
+    let look = p.look();
+    let name = p.name();
+    let dimming = p.lamp.and_then(|l| l.dimming);
+    let snr = p.lamp.and_then(|l| l.snr);
+    let mut title = name;
     if p.pole.is_some() {
         title.push_str(&format!(" ({})", p.address));
     }
@@ -183,117 +420,80 @@ fn lamp(p: &Place, x: i32, y: i32, cy: i32, w: i32, named: bool) -> String {
     if let Some(s) = snr {
         title.push_str(&format!("; SNR {s} dB"));
     }
-    // A lamp not heard has no page to open.
-    let address = match p.lamp {
-        Some(_) => format!(" data-address=\"{}\"", p.address),
-        None => String::new(),
-    };
-    let mut g = format!(
-        "<g class=\"pk-lamp\"{address} data-look=\"{}\"><title>{}</title><rect class=\"pk-hit\" x=\"{x}\" y=\"{y}\" width=\"{w}\" height=\"{}\"/>",
-        look_key(look),
-        esc(&title),
-        if named { 80 } else { 26 }
-    );
-    let r = match (named, look.in_trouble()) {
-        (true, true) => 11,
-        (true, false) => 9,
-        (false, true) => 8,
-        (false, false) => 6,
-    };
-    if look.in_trouble() {
-        g.push_str(&format!(
-            "<circle class=\"pk-halo\" cx=\"{cx}\" cy=\"{cy}\" r=\"{}\"/>",
-            r + r / 2 + 2
-        ));
-    }
-    g.push_str(&mark(look, cx, cy, r));
-    let bar = |at: i32, full: i32| {
-        let len = snr.map_or(0, |s| (i32::from(s).clamp(0, SNR_FULL) * full) / SNR_FULL);
-        // Named, the bar leaves room for its figure on its right.
-        let x = if named { cx - 40 } else { cx - full / 2 };
-        format!(
-            "<rect class=\"pk-track\" x=\"{x}\" y=\"{at}\" width=\"{full}\" height=\"3\"/><rect class=\"pk-snr\" x=\"{x}\" y=\"{at}\" width=\"{len}\" height=\"3\"/>"
-        )
-    };
-    if named {
-        if let Some(m) = p.pole.and_then(|p| p.position) {
-            g.push_str(&format!(
-                "<text class=\"pk-small\" x=\"{cx}\" y=\"{}\">{m} m</text>",
-                y + 9
-            ));
-        }
-        let short: String = if name.chars().count() > 15 {
-            name.chars().take(14).chain(['…']).collect()
-        } else {
-            name
-        };
-        g.push_str(&format!(
-            "<text class=\"pk-name\" x=\"{cx}\" y=\"{}\">{}</text>",
-            y + 48,
-            esc(&short)
-        ));
-        if let Some(d) = dimming {
-            g.push_str(&format!(
-                "<text class=\"pk-small\" x=\"{cx}\" y=\"{}\">dim set {d} %</text>",
-                y + 61
-            ));
-        }
-        g.push_str(&bar(y + 69, 50));
-        if let Some(s) = snr {
-            g.push_str(&format!(
-                "<text class=\"pk-small pk-db\" x=\"{}\" y=\"{}\">{s} dB</text>",
-                cx + 14,
-                y + 73
-            ));
-        }
-    } else {
-        g.push_str(&bar(y + 19, 16));
-    }
-    g.push_str("</g>");
-    g
+    title
 }
 
 /// A look's mark centred on `cx`, `cy`, of radius `r`: a disc running, a
 /// half disc dimmed, a diamond starting, a ring off, a triangle failed, a
 /// dashed ring not answering, a small dot not read.
 fn mark(look: Look, cx: i32, cy: i32, r: i32) -> String {
-    let key = look_key(look);
-    match look {
-        Look::Running => format!("<circle class=\"pk-{key}\" cx=\"{cx}\" cy=\"{cy}\" r=\"{r}\"/>"),
-        Look::Dimmed => format!(
-            "<circle class=\"pk-ring pk-run\" cx=\"{cx}\" cy=\"{cy}\" r=\"{}\"/><path class=\"pk-run\" d=\"M{cx} {}A{r} {r} 0 0 0 {cx} {}Z\"/>",
-            r - 1,
-            cy - r,
-            cy + r
-        ),
-        Look::Between => format!(
-            "<path class=\"pk-{key}\" d=\"M{cx} {}L{} {cy}L{cx} {}L{} {cy}Z\"/>",
-            cy - r,
-            cx + r,
-            cy + r,
-            cx - r
-        ),
-        Look::Off => format!(
-            "<circle class=\"pk-ring pk-{key}\" cx=\"{cx}\" cy=\"{cy}\" r=\"{}\"/>",
-            r - 1
-        ),
-        Look::Failed => format!(
-            "<path class=\"pk-{key}\" d=\"M{cx} {}L{} {}L{} {}Z\"/>",
-            cy - r - 1,
-            cx + r + 1,
-            cy + r - 1,
-            cx - r - 1,
-            cy + r - 1
-        ),
-        Look::Unreachable => format!(
-            "<circle class=\"pk-ring pk-{key}\" cx=\"{cx}\" cy=\"{cy}\" r=\"{}\"/>",
-            r - 1
-        ),
-        Look::NotRead => format!(
-            "<circle class=\"pk-{key}\" cx=\"{cx}\" cy=\"{cy}\" r=\"{}\"/>",
-            r / 2
-        ),
+    let mut svg = String::new();
+    for (class, d) in shapes(look, cx, cy, r) {
+        svg.push_str(&format!("<path class=\"{class}\" d=\"{d}\"/>"));
     }
+    svg
+}
+
+/// The classes of [`shapes`] in the order they are drawn, bottom first
+/// (style.css gives each its colour).
+pub const SHAPE_CLASSES: [&str; 7] = [
+    "pk-run",
+    "pk-ring pk-run",
+    "pk-between",
+    "pk-ring pk-off",
+    "pk-failed",
+    "pk-ring pk-silent",
+    "pk-unread",
+];
+
+/// A look's mark as SVG path data, each with its class (one of
+/// [`SHAPE_CLASSES`]).
+fn shapes(look: Look, cx: i32, cy: i32, r: i32) -> Vec<(&'static str, String)> {
+    let c = SHAPE_CLASSES;
+    match look {
+        Look::Running => vec![(c[0], circle(cx, cy, r))],
+        Look::Dimmed => vec![
+            (c[1], circle(cx, cy, r - 1)),
+            (
+                c[0],
+                format!("M{cx} {}A{r} {r} 0 0 0 {cx} {}Z", cy - r, cy + r),
+            ),
+        ],
+        Look::Between => vec![(
+            c[2],
+            format!(
+                "M{cx} {}L{} {cy}L{cx} {}L{} {cy}Z",
+                cy - r,
+                cx + r,
+                cy + r,
+                cx - r
+            ),
+        )],
+        Look::Off => vec![(c[3], circle(cx, cy, r - 1))],
+        Look::Failed => vec![(
+            c[4],
+            format!(
+                "M{cx} {}L{} {}L{} {}Z",
+                cy - r - 1,
+                cx + r + 1,
+                cy + r - 1,
+                cx - r - 1,
+                cy + r - 1
+            ),
+        )],
+        Look::Unreachable => vec![(c[5], circle(cx, cy, r - 1))],
+        Look::NotRead => vec![(c[6], circle(cx, cy, r / 2))],
+    }
+}
+
+/// A circle as path data (two arcs), so that many join in one path.
+fn circle(cx: i32, cy: i32, r: i32) -> String {
+    format!(
+        "M{} {cy}a{r} {r} 0 1 0 {} 0a{r} {r} 0 1 0 {} 0",
+        cx - r,
+        2 * r,
+        -2 * r
+    )
 }
 
 /// A look as a word for classes and `data-look`.
@@ -336,6 +536,12 @@ mod tests {
             .collect()
     }
 
+    /// The whole picture as one piece of HTML.
+    fn html(fleet: &BTreeMap<Address, Lamp>, poles: Option<&[Pole]>) -> String {
+        let p = picture(fleet, poles, None);
+        format!("{}{}", p.head, p.street())
+    }
+
     /// The addresses of the clickable lamps, in the picture's order.
     fn order(html: &str) -> Vec<String> {
         html.split("data-address=\"")
@@ -355,7 +561,7 @@ mod tests {
         // Twelve named lamps in one row, each with its SNR bar (20 of 30 dB).
         assert!(html.contains("viewBox=\"0 0 1320 80\""), "{html}");
         assert_eq!(html.matches("class=\"pk-snr\"").count(), 12);
-        assert!(html.contains("width=\"33\" height=\"3\""));
+        assert!(html.contains("d=\"M15 69h33v3h-33Z\""));
         assert_eq!(html.matches(">20 dB</text>").count(), 12);
         assert!(html.contains("running 12"));
     }
@@ -435,18 +641,83 @@ mod tests {
     }
 
     #[test]
-    fn five_hundred_lamps_fit_in_nine_small_rows() {
+    fn five_hundred_lamps_fit_in_nine_small_rows_of_a_few_paths() {
         let mut fleet = street(500);
         fleet.get_mut(&a(433)).unwrap().unreachable = Some("silent".into());
-        let html = html(&fleet, None);
+        let p = picture(&fleet, None, Some(a(2)));
+        let html = format!("{}{}", p.head, p.street());
         assert!(html.contains("viewBox=\"0 0 1320 234\""), "9 rows of 26");
-        assert_eq!(order(&html).len(), 500);
+        assert!(p.marks.is_empty() && order(&html).is_empty());
+        // Tracks, bars, the ring in trouble, two kinds of mark: 5 paths
+        // besides the legend's 8.
+        assert_eq!(p.street().matches("<path").count(), 5);
+        assert_eq!(
+            html.matches("pk-ring pk-silent").count(),
+            2,
+            "one in the legend"
+        );
         assert!(
             !html.contains("class=\"pk-name\""),
             "no words under small marks"
         );
-        assert!(html.contains("<title>0080e10001b1: not answering; SNR 20 dB</title>"));
         assert!(html.contains(">465</text>"), "rows numbered");
         assert!(html.contains("In trouble: 0080e10001b1 not answering"));
+        // Lamp 433 is the 433rd cell: row 7, column 26 (58 to a row).
+        let cell = p
+            .grid
+            .at(34.0 + 26.0 * 22.0 + 11.0, 7.0 * 26.0 + 5.0)
+            .unwrap();
+        assert_eq!(cell.address, Some(a(433)));
+        assert_eq!(cell.title, "0080e10001b1: not answering; SNR 20 dB");
+        assert!(p.grid.at(20.0, 5.0).is_none(), "the row numbers' margin");
+        assert!(p.grid.at(1319.0, 5.0).is_none(), "past the last column");
+        assert!(
+            p.grid.at(40.0, 9.0 * 26.0 + 1.0).is_none(),
+            "below the street"
+        );
+        assert_eq!(html.matches("pk-focus").count(), 1, "the open lamp's cell");
+    }
+
+    #[test]
+    fn a_reading_changes_its_lamps_mark_alone_and_the_open_lamp_is_marked() {
+        let mut fleet = street(30);
+        let before = picture(&fleet, None, None);
+        assert_eq!(before.marks.len(), 30);
+        fleet.get_mut(&a(20)).unwrap().snr = Some(9);
+        let after = picture(&fleet, None, None);
+        assert!(after.head == before.head && after.rows == before.rows);
+        let changed: Vec<usize> = (0..30)
+            .filter(|i| after.marks[*i] != before.marks[*i])
+            .collect();
+        assert_eq!(changed, [19]);
+        let focused = picture(&fleet, None, Some(a(7)));
+        assert!(focused.marks[6]
+            .body
+            .starts_with(" class=\"pk-lamp pk-focus\""));
+        assert_eq!(focused.street().matches("pk-focus").count(), 1);
+    }
+
+    #[test]
+    fn a_lamp_found_moves_the_marks_after_it_without_changing_them() {
+        let mut fleet = street(30);
+        let gone = fleet.remove(&a(20)).unwrap();
+        let before = picture(&fleet, None, None);
+        fleet.insert(a(20), gone);
+        let after = picture(&fleet, None, None);
+        assert_eq!(after.marks.len(), 30);
+        for (i, was) in before.marks.iter().enumerate() {
+            if was.address < a(20) {
+                assert!(*was == after.marks[i]);
+            } else {
+                // In the next cell over, drawn the same in it.
+                let is = &after.marks[i + 1];
+                assert!(was.body == is.body && was.at != is.at);
+            }
+        }
+        // 12 to a row: the 20th is the 8th of the second row.
+        assert_eq!(after.marks[19].address, a(20));
+        assert!(after.marks[19]
+            .html()
+            .starts_with("<g transform=\"translate(770 80)\""));
     }
 }

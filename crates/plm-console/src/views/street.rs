@@ -59,7 +59,7 @@ pub fn StreetView() -> impl IntoView {
     // (`widgets::draw_rows`), each written as HTML, so that 500 lamps lay
     // out as fast as 30.
     let top = signal(0u32);
-    Effect::new(move |drawn: Option<String>| {
+    Effect::new(move |drawn: Option<Vec<String>>| {
         let top = top.get();
         let focused = focus.get();
         selected.with(|picked| {

@@ -55,7 +55,7 @@ pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
     let top = signal(0u32);
     let follow = signal(true);
     // Only the rows in view are in the page (`widgets::draw_rows`).
-    Effect::new(move |drawn: Option<String>| {
+    Effect::new(move |drawn: Option<Vec<String>>| {
         let follow = follow.get();
         let top = if follow { 0 } else { top.get() };
         let chosen = selected.get();

@@ -12,6 +12,7 @@ use super::widgets::{
 };
 use crate::campaign_store;
 use crate::stores::{use_console, StreetStore};
+use crate::tab::Tab;
 use leptos::prelude::*;
 use plm_core::app::rfu::image::{self, Image};
 use plm_core::app::{Address, Release};
@@ -90,8 +91,16 @@ fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
 
 /// The view.
 #[component]
-pub fn UpdateView() -> impl IntoView {
+pub fn UpdateView(tab: RwSignal<String>) -> impl IntoView {
     let street = use_console().street;
+    let choice = signal(String::from("all"));
+    // The lamps to choose from, written only when they differ; hidden, not
+    // brought up to date at all (the street's readings would rewrite 500
+    // options for nothing): its tab brings them up to date.
+    let options = Memo::new(move |last: Option<&String>| match last {
+        Some(l) if tab.get() != Tab::Update.slug() => l.clone(),
+        _ => target_options(street, choice),
+    });
     let chosen = signal(0u32);
     let choose = move |c: Chosen| {
         CHOSEN.with_borrow_mut(|x| *x = Some(c));
@@ -101,7 +110,6 @@ pub fn UpdateView() -> impl IntoView {
         chosen.track();
         with_chosen(|c| c.is_some_and(|c| c.check.is_ok() == ok))
     };
-    let choice = signal(String::from("all"));
     let message = signal(None::<String>);
     let make_release = signal(String::from("1.5"));
     let stated = signal(String::new());
@@ -235,7 +243,7 @@ pub fn UpdateView() -> impl IntoView {
                     "Lamps "
                     {select(
                         "update-targets",
-                        Box::new(move || target_options(street, choice)),
+                        Box::new(move || options.get()),
                         Box::new(move |v| choice.set(v)),
                     )}
                 </label>

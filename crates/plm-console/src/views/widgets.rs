@@ -261,26 +261,25 @@ pub fn closest(ev: &web_sys::Event, selector: &str) -> Option<web_sys::Element> 
 
 /// Draws the rows of the long table `table_id` that are in view
 /// ([`crate::long_table::window`] of `total` rows, scrolled to `top_px`
-/// or following the newest): `rows` writes them as HTML into its body,
-/// and the table's margins keep the room of the others. `drawn` is what
-/// the body held (it is written only when that changes); returns what it
-/// holds now. The table's `data-rows` says how many rows it has in all.
+/// or following the newest): `rows` writes each as HTML into its body
+/// ([`patch_children`]), and the table's margins keep the room of the
+/// others. `drawn` is what the body held; returns what it holds now. The
+/// table's `data-rows` says how many rows it has in all.
 pub fn draw_rows(
     table_id: &str,
     total: usize,
     top_px: u32,
     follow: bool,
-    rows: &mut dyn FnMut(std::ops::Range<usize>) -> String,
-    drawn: Option<String>,
-) -> String {
+    rows: &mut dyn FnMut(std::ops::Range<usize>) -> Vec<String>,
+    drawn: Option<Vec<String>>,
+) -> Vec<String> {
     use crate::long_table::ROW_PX;
     // The table's height at most (style.css `.table-wrap`: 100vh - 190px).
     let page_px = window().inner_height().ok().and_then(|h| h.as_f64());
     let view_px = (page_px.unwrap_or(900.0) - 190.0).max(220.0) as u32;
     let w = crate::long_table::window(total, top_px, view_px, follow);
     let (above, below) = (w.start as u32, (total - w.end) as u32);
-    let html = rows(w);
-    let mut drawn = drawn.unwrap_or_default();
+    let now = rows(w);
     let doc = document();
     if let (Some(table), Ok(Some(body))) = (
         doc.get_element_by_id(table_id),
@@ -289,12 +288,30 @@ pub fn draw_rows(
         let margin = format!("margin: {}px 0 {}px", above * ROW_PX, below * ROW_PX);
         let _ = table.set_attribute("style", &margin);
         let _ = table.set_attribute("data-rows", &total.to_string());
-        if drawn != html {
-            body.set_inner_html(&html);
-            drawn = html;
+        patch_children(&body, drawn.as_deref().unwrap_or_default(), &now);
+    }
+    now
+}
+
+/// Brings `parent`'s children, written as `drawn` (one element's HTML
+/// each), to `now`: only the children that differ are written again, so
+/// that a reading of one lamp out of 500 parses and lays out one row or
+/// mark; all of them at once when their number changed or most differ.
+pub fn patch_children(parent: &web_sys::Element, drawn: &[String], now: &[String]) {
+    let same_count = drawn.len() == now.len() && parent.child_element_count() as usize == now.len();
+    let differ = drawn.iter().zip(now).filter(|(a, b)| a != b).count();
+    if !same_count || differ * 2 > now.len() {
+        parent.set_inner_html(&now.concat());
+        return;
+    }
+    let mut child = parent.first_element_child();
+    for (was, is) in drawn.iter().zip(now) {
+        let Some(el) = child else { return };
+        child = el.next_element_sibling();
+        if was != is {
+            el.set_outer_html(is);
         }
     }
-    drawn
 }
 
 /// Where the scrolling box of a long table (`wrap`, a selector) that `ev`

@@ -1,16 +1,24 @@
 //! The street picture above the fleet table ([`crate::fleet::picture`]),
 //! with the pole list's import (`plm_core::file::poles`), kept in the
-//! browser's storage. The picture is written as HTML when the fleet or
-//! the list changes; one click listener opens the page of the lamp
-//! clicked, by its `data-address`.
+//! browser's storage. The picture is written as HTML when the fleet, the
+//! list or the lamp whose page is open changes, only what differs; one
+//! click listener opens the page of the lamp clicked, by its
+//! `data-address`.
 
-use super::row_key;
+use super::{key_address, row_key};
+use crate::fleet::picture::{Cell, Grid, Mark, Picture, WIDTH};
 use crate::stores::use_console;
 use crate::views::files;
 use crate::views::widgets::{button, closest, note, on_click, on_event, signal};
 use leptos::prelude::*;
 use plm_core::app::Address;
 use plm_core::file::poles::{self, POLE_LIST_MAX};
+use std::cell::RefCell;
+
+thread_local! {
+    /// The small marks' cells as last drawn, for the pointer (`cell_at`).
+    static GRID: RefCell<Grid> = RefCell::default();
+}
 
 /// Where the pole list is kept (its text, as imported).
 const KEY: &str = "plm-console.poles";
@@ -31,21 +39,49 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
             )));
         }
     }
-    Effect::new(move |drawn: Option<String>| {
+    // Drawn when the fleet, the list or the open lamp changes: of the
+    // heading and the street only what differs (`patch_marks`).
+    Effect::new(move |drawn: Option<Picture>| {
         street.version.track();
-        let html = list.with(|text| {
+        let open = focus.get().map(key_address);
+        let now = list.with(|text| {
             let poles = (!text.is_empty())
                 .then(|| poles::parse(text.as_bytes()).ok())
                 .flatten();
-            street.with_fleet(|f| crate::fleet::picture::html(f, poles.as_deref()))
+            street.with_fleet(|f| crate::fleet::picture::picture(f, poles.as_deref(), open))
         });
-        let Some(el) = document().get_element_by_id("street-picture") else {
-            return String::new();
+        let doc = document();
+        let (Some(head), Some(svg)) = (
+            doc.get_element_by_id("street-picture-head"),
+            doc.get_element_by_id("street-picture-street"),
+        ) else {
+            return Picture::default();
         };
-        if drawn.as_ref() != Some(&html) {
-            el.set_inner_html(&html);
+        let drawn = drawn.unwrap_or_default();
+        if drawn.head != now.head {
+            head.set_inner_html(&now.head);
         }
-        html
+        let parts = svg.query_selector("svg").ok().flatten().zip(
+            svg.query_selector(".pk-rows")
+                .ok()
+                .flatten()
+                .zip(svg.query_selector(".pk-marks").ok().flatten()),
+        );
+        match parts {
+            Some((frame, (rows, marks))) if !now.view_box.is_empty() => {
+                if drawn.view_box != now.view_box {
+                    let _ = frame.set_attribute("viewBox", &now.view_box);
+                }
+                if drawn.rows != now.rows {
+                    rows.set_inner_html(&now.rows);
+                }
+                patch_marks(&marks, &drawn.marks, &now.marks);
+            }
+            _ => svg.set_inner_html(&now.street()),
+        }
+        let mut now = now;
+        GRID.set(std::mem::take(&mut now.grid));
+        now
     });
     let import = move |ev: web_sys::Event| {
         let Some(file) = files::chosen_file(&ev) else {
@@ -102,14 +138,82 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
         {move || (message.with(|m| m.is_some())).then(|| note("street-poles-note", "muted", message))}
         <div
             id="street-picture"
+            inner_html="<div id=\"street-picture-head\"></div><div id=\"street-picture-street\"></div>"
             on:click=on_click(move |ev| {
                 let address = closest(&ev, "[data-address]")
                     .and_then(|el| el.get_attribute("data-address"))
-                    .and_then(|hex| Address::parse(&hex).ok());
+                    .and_then(|hex| Address::parse(&hex).ok())
+                    .or_else(|| cell_at(&ev, |c| c.address).flatten());
                 if let Some(a) = address {
                     focus.set(Some(row_key(a)));
                 }
             })
+            on:mousemove=on_click(|ev| {
+                // A small mark's words, as a tooltip.
+                let title = cell_at(&ev, |c| c.title.clone());
+                if let Some(el) = closest(&ev, "#street-picture-street") {
+                    let _ = match title {
+                        Some(t) => el.set_attribute("title", &t),
+                        None => el.remove_attribute("title"),
+                    };
+                }
+            })
         ></div>
     }
+}
+
+/// Brings the marks drawn in `parent` to `now`: a mark that changed is
+/// written again, a mark that only moved (a lamp found before it in the
+/// street's order) is moved by its `transform`, a new one is written in
+/// its place; anything else (the order changed, lamps gone, most of them
+/// new) draws them all again.
+fn patch_marks(parent: &web_sys::Element, drawn: &[Mark], now: &[Mark]) {
+    // The marks drawn are still in order, among the new ones.
+    let mut left = now.iter();
+    let kept = drawn.iter().all(|d| left.any(|m| m.address == d.address));
+    let new = now.len() - drawn.len().min(now.len());
+    if !kept || parent.child_element_count() as usize != drawn.len() || new * 2 > now.len() {
+        parent.set_inner_html(&now.iter().map(Mark::html).collect::<String>());
+        return;
+    }
+    let mut old = drawn.iter();
+    let mut at = old.next();
+    let mut next = parent.first_element_child();
+    for m in now {
+        match (at, next.clone()) {
+            (Some(d), Some(el)) if d.address == m.address => {
+                next = el.next_element_sibling();
+                at = old.next();
+                if d.body != m.body {
+                    el.set_outer_html(&m.html());
+                } else if d.at != m.at {
+                    let _ = el.set_attribute("transform", &m.at);
+                }
+            }
+            (_, Some(el)) => {
+                let _ = el.insert_adjacent_html("beforebegin", &m.html());
+            }
+            (_, None) => {
+                let _ = parent.insert_adjacent_html("beforeend", &m.html());
+            }
+        }
+    }
+}
+
+/// What `read` says of the small mark's cell under the pointer of `ev`
+/// (none over a named mark, a margin or no picture).
+fn cell_at<T>(ev: &web_sys::MouseEvent, read: impl FnOnce(&Cell) -> T) -> Option<T> {
+    let r = closest(ev, "svg.pk")?.get_bounding_client_rect();
+    if r.width() <= 0.0 {
+        return None;
+    }
+    // The picture keeps its proportions: one scale for both axes.
+    let scale = f64::from(WIDTH) / r.width();
+    // web-sys has clientX as an f64 for wasm32, an i32 natively.
+    #[allow(clippy::useless_conversion)]
+    let (x, y) = (
+        (f64::from(ev.client_x()) - r.left()) * scale,
+        (f64::from(ev.client_y()) - r.top()) * scale,
+    );
+    GRID.with_borrow(|g| g.at(x, y).map(read))
 }
