@@ -31,6 +31,7 @@ pub mod session;
 pub mod storage;
 pub mod street;
 pub mod tab;
+pub mod throttle;
 pub mod traffic;
 pub mod transport;
 

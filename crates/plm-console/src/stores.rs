@@ -9,6 +9,7 @@ use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
 use crate::storage::load;
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::street_store;
+use crate::throttle::Throttle;
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
 use crate::transport::Transport;
@@ -37,6 +38,17 @@ pub const LINE_EVENTS: usize = 200;
 /// The longest the page sleeps with nothing due, µs: within the session's
 /// catch-up limit, so that a simulated world keeps the page's time.
 pub const IDLE_WAKE_US: f64 = 50_000.0;
+
+/// The Street and Firmware update views are drawn again at most five
+/// times a second; a change waits at most this and one tick
+/// ([`IDLE_WAKE_US`]).
+pub const STREET_DRAW_US: f64 = 200_000.0;
+
+thread_local! {
+    /// When the street's changes were last shown.
+    static STREET_SHOWN: std::cell::RefCell<Throttle> =
+        const { std::cell::RefCell::new(Throttle::new(STREET_DRAW_US)) };
+}
 
 /// How long a hardware reset holds RESETN low (DTR asserted). UM0932
 /// gives no minimum; 20 ms is far beyond any reset filter.
@@ -766,7 +778,7 @@ impl Console {
         let street = self.street;
         set_if_changed(street.sweep, sweep);
         set_if_changed(street.discovering, discovering);
-        if changed {
+        if STREET_SHOWN.with_borrow_mut(|t| t.show(changed, page_now_us())) {
             street.now.set(now);
             street.version.update(|v| *v += 1);
             street.keep_history(false);

@@ -59,15 +59,16 @@ pub fn StreetView() -> impl IntoView {
     // (`widgets::draw_rows`), each written as HTML, so that 500 lamps lay
     // out as fast as 30.
     let top = signal(0u32);
-    Effect::new(move |drawn: Option<Vec<String>>| {
+    Effect::new(move |drawn: Option<Vec<(u64, String)>>| {
         let top = top.get();
         let focused = focus.get();
         selected.with(|picked| {
             rows.with(|all| {
                 let mut html = |w: std::ops::Range<usize>| {
                     let row = |r: &Row| {
-                        let focus = focused == Some(row_key(r.address));
-                        row_html(r, picked.contains(&r.address), focus)
+                        let key = row_key(r.address);
+                        let html = row_html(r, picked.contains(&r.address), focused == Some(key));
+                        (key, html)
                     };
                     all[w].iter().map(row).collect()
                 };

@@ -55,13 +55,17 @@ pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
     let top = signal(0u32);
     let follow = signal(true);
     // Only the rows in view are in the page (`widgets::draw_rows`).
-    Effect::new(move |drawn: Option<Vec<String>>| {
+    Effect::new(move |drawn: Option<Vec<(u64, String)>>| {
         let follow = follow.get();
         let top = if follow { 0 } else { top.get() };
         let chosen = selected.get();
         let drawn = rows.with(|(_, all)| {
-            let mut html =
-                |w: std::ops::Range<usize>| all[w].iter().map(|e| row_html(e, chosen)).collect();
+            let mut html = |w: std::ops::Range<usize>| {
+                all[w]
+                    .iter()
+                    .map(|e| (e.seq, row_html(e, chosen)))
+                    .collect()
+            };
             draw_rows("traffic-table", all.len(), top, follow, &mut html, drawn)
         });
         if follow {

@@ -261,8 +261,8 @@ pub fn closest(ev: &web_sys::Event, selector: &str) -> Option<web_sys::Element> 
 
 /// Draws the rows of the long table `table_id` that are in view
 /// ([`crate::long_table::window`] of `total` rows, scrolled to `top_px`
-/// or following the newest): `rows` writes each as HTML into its body
-/// ([`patch_children`]), and the table's margins keep the room of the
+/// or following the newest): `rows` writes each as HTML with its key
+/// ([`patch_keyed`]), and the table's margins keep the room of the
 /// others. `drawn` is what the body held; returns what it holds now. The
 /// table's `data-rows` says how many rows it has in all.
 pub fn draw_rows(
@@ -270,9 +270,9 @@ pub fn draw_rows(
     total: usize,
     top_px: u32,
     follow: bool,
-    rows: &mut dyn FnMut(std::ops::Range<usize>) -> Vec<String>,
-    drawn: Option<Vec<String>>,
-) -> Vec<String> {
+    rows: &mut dyn FnMut(std::ops::Range<usize>) -> Vec<(u64, String)>,
+    drawn: Option<Vec<(u64, String)>>,
+) -> Vec<(u64, String)> {
     use crate::long_table::ROW_PX;
     // The table's height at most (style.css `.table-wrap`: 100vh - 190px).
     let page_px = window().inner_height().ok().and_then(|h| h.as_f64());
@@ -288,29 +288,57 @@ pub fn draw_rows(
         let margin = format!("margin: {}px 0 {}px", above * ROW_PX, below * ROW_PX);
         let _ = table.set_attribute("style", &margin);
         let _ = table.set_attribute("data-rows", &total.to_string());
-        patch_children(&body, drawn.as_deref().unwrap_or_default(), &now);
+        patch_keyed(&body, drawn.as_deref().unwrap_or_default(), &now);
     }
     now
 }
 
 /// Brings `parent`'s children, written as `drawn` (one element's HTML
-/// each), to `now`: only the children that differ are written again, so
-/// that a reading of one lamp out of 500 parses and lays out one row or
-/// mark; all of them at once when their number changed or most differ.
-pub fn patch_children(parent: &web_sys::Element, drawn: &[String], now: &[String]) {
-    let same_count = drawn.len() == now.len() && parent.child_element_count() as usize == now.len();
-    let differ = drawn.iter().zip(now).filter(|(a, b)| a != b).count();
-    if !same_count || differ * 2 > now.len() {
-        parent.set_inner_html(&now.concat());
+/// each, with its key), to `now`: an element whose key stays and whose
+/// HTML is the same is left alone, one whose HTML changed is written
+/// again, the new ones are written in their place and the others removed.
+/// A reading of one lamp of 500, or a lamp found among the rows shown,
+/// is one or two elements to parse and lay out, not all of them; when
+/// most are new (a scroll, a sort) they are written all at once.
+pub fn patch_keyed(parent: &web_sys::Element, drawn: &[(u64, String)], now: &[(u64, String)]) {
+    let shown = |key: u64| now.iter().any(|(k, _)| *k == key);
+    let kept = drawn.iter().filter(|(k, _)| shown(*k)).count();
+    if parent.child_element_count() as usize != drawn.len() || kept * 2 < now.len() {
+        parent.set_inner_html(&now.iter().map(|(_, h)| h.as_str()).collect::<String>());
         return;
     }
-    let mut child = parent.first_element_child();
-    for (was, is) in drawn.iter().zip(now) {
-        let Some(el) = child else { return };
-        child = el.next_element_sibling();
-        if was != is {
-            el.set_outer_html(is);
+    let mut old = drawn.iter().peekable();
+    let mut at = parent.first_element_child();
+    for (key, html) in now {
+        // The drawn elements no longer shown, before this one, go.
+        while let (Some((k, _)), Some(el)) = (old.peek(), at.clone()) {
+            if *k == *key || shown(*k) {
+                break;
+            }
+            at = el.next_element_sibling();
+            el.remove();
+            old.next();
         }
+        match (old.peek(), at.clone()) {
+            (Some((k, was)), Some(el)) if k == key => {
+                at = el.next_element_sibling();
+                if was != html {
+                    el.set_outer_html(html);
+                }
+                old.next();
+            }
+            (_, Some(el)) => {
+                let _ = el.insert_adjacent_html("beforebegin", html);
+            }
+            (_, None) => {
+                let _ = parent.insert_adjacent_html("beforeend", html);
+            }
+        }
+    }
+    // What is left was drawn and is not shown any more.
+    while let Some(el) = at {
+        at = el.next_element_sibling();
+        el.remove();
     }
 }
 

@@ -9,7 +9,7 @@ use super::{key_address, row_key};
 use crate::fleet::picture::{Cell, Grid, Mark, Picture, WIDTH};
 use crate::stores::use_console;
 use crate::views::files;
-use crate::views::widgets::{button, closest, note, on_click, on_event, signal};
+use crate::views::widgets::{button, closest, note, on_click, on_event, patch_keyed, signal};
 use leptos::prelude::*;
 use plm_core::app::Address;
 use plm_core::file::poles::{self, POLE_LIST_MAX};
@@ -40,7 +40,7 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
         }
     }
     // Drawn when the fleet, the list or the open lamp changes: of the
-    // heading and the street only what differs (`patch_marks`).
+    // heading and the street only what differs (`widgets::patch_keyed`).
     Effect::new(move |drawn: Option<Picture>| {
         street.version.track();
         let open = focus.get().map(key_address);
@@ -75,7 +75,10 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
                 if drawn.rows != now.rows {
                     rows.set_inner_html(&now.rows);
                 }
-                patch_marks(&marks, &drawn.marks, &now.marks);
+                let keyed = |m: &[Mark]| -> Vec<(u64, String)> {
+                    m.iter().map(|m| (row_key(m.address), m.html())).collect()
+                };
+                patch_keyed(&marks, &keyed(&drawn.marks), &keyed(&now.marks));
             }
             _ => svg.set_inner_html(&now.street()),
         }
@@ -159,44 +162,6 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
                 }
             })
         ></div>
-    }
-}
-
-/// Brings the marks drawn in `parent` to `now`: a mark that changed is
-/// written again, a mark that only moved (a lamp found before it in the
-/// street's order) is moved by its `transform`, a new one is written in
-/// its place; anything else (the order changed, lamps gone, most of them
-/// new) draws them all again.
-fn patch_marks(parent: &web_sys::Element, drawn: &[Mark], now: &[Mark]) {
-    // The marks drawn are still in order, among the new ones.
-    let mut left = now.iter();
-    let kept = drawn.iter().all(|d| left.any(|m| m.address == d.address));
-    let new = now.len() - drawn.len().min(now.len());
-    if !kept || parent.child_element_count() as usize != drawn.len() || new * 2 > now.len() {
-        parent.set_inner_html(&now.iter().map(Mark::html).collect::<String>());
-        return;
-    }
-    let mut old = drawn.iter();
-    let mut at = old.next();
-    let mut next = parent.first_element_child();
-    for m in now {
-        match (at, next.clone()) {
-            (Some(d), Some(el)) if d.address == m.address => {
-                next = el.next_element_sibling();
-                at = old.next();
-                if d.body != m.body {
-                    el.set_outer_html(&m.html());
-                } else if d.at != m.at {
-                    let _ = el.set_attribute("transform", &m.at);
-                }
-            }
-            (_, Some(el)) => {
-                let _ = el.insert_adjacent_html("beforebegin", &m.html());
-            }
-            (_, None) => {
-                let _ = parent.insert_adjacent_html("beforeend", &m.html());
-            }
-        }
     }
 }
 
