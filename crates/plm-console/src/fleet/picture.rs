@@ -63,16 +63,12 @@ fn places<'a>(fleet: &'a BTreeMap<Address, Lamp>, poles: &'a [Pole]) -> Vec<Plac
     listed.chain(rest).collect()
 }
 
-/// The picture in parts, so that a change to a few lamps is drawn as
-/// those lamps' marks alone: its heading and legend, the street's size
-/// (an SVG `viewBox`, empty without lamps), the rows' cables and numbers,
-/// and each lamp's mark in the street's order.
+/// The picture in two parts, each written again only when it changed:
+/// its heading and legend, and the street (SVG, empty without lamps).
 #[derive(Default, PartialEq)]
 pub struct Picture {
     pub head: String,
-    pub view_box: String,
-    pub rows: String,
-    pub marks: Vec<Mark>,
+    pub street: String,
     pub grid: Grid,
 }
 
@@ -103,41 +99,6 @@ impl Grid {
             return None;
         }
         self.cells.get(row as usize * self.per_row + col as usize)
-    }
-}
-
-/// One lamp's mark: drawn in its own cell's coordinates (`body`, an SVG
-/// group's attributes after its `transform` and its content), moved to
-/// its cell by `at` (`translate(x y)`), so that a lamp found earlier in
-/// the street's order moves the marks after it without writing them again.
-#[derive(PartialEq)]
-pub struct Mark {
-    pub address: Address,
-    pub at: String,
-    pub body: String,
-}
-
-impl Mark {
-    pub fn html(&self) -> String {
-        format!("<g transform=\"{}\"{}", self.at, self.body)
-    }
-}
-
-impl Picture {
-    /// The street's SVG (empty without lamps): its rows, then its marks.
-    pub fn street(&self) -> String {
-        if self.view_box.is_empty() {
-            return String::new();
-        }
-        let mut svg = format!(
-            "<svg class=\"pk\" viewBox=\"{}\" role=\"img\" aria-label=\"the street\"><g class=\"pk-rows\">{}</g><g class=\"pk-marks\">",
-            self.view_box, self.rows
-        );
-        for m in &self.marks {
-            svg.push_str(&m.html());
-        }
-        svg.push_str("</g></svg>");
-        svg
     }
 }
 
@@ -215,9 +176,11 @@ pub fn picture(
     let (w, h, left) = if named { (110, 80, 0) } else { (22, 26, 34) };
     let per_row = ((WIDTH - left) / w) as usize;
     let rows = places.len().div_ceil(per_row);
-    picture.view_box = format!("0 0 {WIDTH} {}", rows as i32 * h);
     let cy = if named { 24 } else { 9 };
-    let mut out = String::new();
+    let mut out = format!(
+        "<svg class=\"pk\" viewBox=\"0 0 {WIDTH} {}\" role=\"img\" aria-label=\"the street\">",
+        rows as i32 * h
+    );
     for (r, row) in places.chunks(per_row).enumerate() {
         let y = r as i32 * h;
         let last = left + (row.len() as i32 - 1) * w + w / 2;
@@ -240,11 +203,10 @@ pub fn picture(
         for (i, place) in places.iter().enumerate() {
             let focused = focus == Some(place.address) && place.lamp.is_some();
             let (x, y) = (left + (i % per_row) as i32 * w, (i / per_row) as i32 * h);
-            picture.marks.push(Mark {
-                address: place.address,
-                at: format!("translate({x} {y})"),
-                body: lamp(place, cy, w, focused),
-            });
+            out.push_str(&format!(
+                "<g transform=\"translate({x} {y})\"{}",
+                lamp(place, cy, w, focused)
+            ));
         }
     } else {
         let grid = Grid {
@@ -266,7 +228,8 @@ pub fn picture(
             ..grid
         };
     }
-    picture.rows = out;
+    out.push_str("</svg>");
+    picture.street = out;
     picture
 }
 
@@ -319,8 +282,8 @@ fn small_marks(places: &[Place], grid: &Grid, cy: i32, focus: Option<Address>) -
 }
 
 /// One place's mark, words and SNR bar in a cell `w` wide, its cable at
-/// `cy` (the cell's coordinates: a [`Mark`]'s body); the lamp whose page
-/// is open `focused`.
+/// `cy` (the cell's coordinates: a group's attributes after its
+/// `transform`, and its content); the lamp whose page is open `focused`.
 fn lamp(p: &Place, cy: i32, w: i32, focused: bool) -> String {
     let look = p.look();
     let cx = w / 2;
@@ -539,7 +502,7 @@ mod tests {
     /// The whole picture as one piece of HTML.
     fn html(fleet: &BTreeMap<Address, Lamp>, poles: Option<&[Pole]>) -> String {
         let p = picture(fleet, poles, None);
-        format!("{}{}", p.head, p.street())
+        format!("{}{}", p.head, p.street)
     }
 
     /// The addresses of the clickable lamps, in the picture's order.
@@ -645,12 +608,12 @@ mod tests {
         let mut fleet = street(500);
         fleet.get_mut(&a(433)).unwrap().unreachable = Some("silent".into());
         let p = picture(&fleet, None, Some(a(2)));
-        let html = format!("{}{}", p.head, p.street());
+        let html = format!("{}{}", p.head, p.street);
         assert!(html.contains("viewBox=\"0 0 1320 234\""), "9 rows of 26");
-        assert!(p.marks.is_empty() && order(&html).is_empty());
+        assert!(order(&html).is_empty(), "no element per lamp");
         // Tracks, bars, the ring in trouble, two kinds of mark: 5 paths
         // besides the legend's 8.
-        assert_eq!(p.street().matches("<path").count(), 5);
+        assert_eq!(p.street.matches("<path").count(), 5);
         assert_eq!(
             html.matches("pk-ring pk-silent").count(),
             2,
@@ -679,45 +642,16 @@ mod tests {
     }
 
     #[test]
-    fn a_reading_changes_its_lamps_mark_alone_and_the_open_lamp_is_marked() {
-        let mut fleet = street(30);
-        let before = picture(&fleet, None, None);
-        assert_eq!(before.marks.len(), 30);
-        fleet.get_mut(&a(20)).unwrap().snr = Some(9);
-        let after = picture(&fleet, None, None);
-        assert!(after.head == before.head && after.rows == before.rows);
-        let changed: Vec<usize> = (0..30)
-            .filter(|i| after.marks[*i] != before.marks[*i])
-            .collect();
-        assert_eq!(changed, [19]);
-        let focused = picture(&fleet, None, Some(a(7)));
-        assert!(focused.marks[6]
-            .body
-            .starts_with(" class=\"pk-lamp pk-focus\""));
-        assert_eq!(focused.street().matches("pk-focus").count(), 1);
-    }
-
-    #[test]
-    fn a_lamp_found_moves_the_marks_after_it_without_changing_them() {
-        let mut fleet = street(30);
-        let gone = fleet.remove(&a(20)).unwrap();
-        let before = picture(&fleet, None, None);
-        fleet.insert(a(20), gone);
-        let after = picture(&fleet, None, None);
-        assert_eq!(after.marks.len(), 30);
-        for (i, was) in before.marks.iter().enumerate() {
-            if was.address < a(20) {
-                assert!(*was == after.marks[i]);
-            } else {
-                // In the next cell over, drawn the same in it.
-                let is = &after.marks[i + 1];
-                assert!(was.body == is.body && was.at != is.at);
-            }
-        }
-        // 12 to a row: the 20th is the 8th of the second row.
-        assert_eq!(after.marks[19].address, a(20));
-        assert!(after.marks[19]
-            .html()
-            .starts_with("<g transform=\"translate(770 80)\""));
+    fn the_lamp_whose_page_is_open_is_marked() {
+        let fleet = street(30);
+        let p = picture(&fleet, None, Some(a(7)));
+        assert_eq!(p.street.matches("pk-focus").count(), 1);
+        assert!(p.street.contains(
+            "<g transform=\"translate(660 0)\" class=\"pk-lamp pk-focus\" data-address=\"0080e1000007\""
+        ));
+        // A lamp not heard has no page to open.
+        assert!(!picture(&fleet, None, Some(a(31)))
+            .street
+            .contains("pk-focus"));
     }
 }

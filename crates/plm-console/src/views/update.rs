@@ -94,13 +94,13 @@ fn targets(street: StreetStore, choice: &str) -> Vec<Address> {
 pub fn UpdateView(tab: RwSignal<String>) -> impl IntoView {
     let street = use_console().street;
     let choice = signal(String::from("all"));
-    // The lamps to choose from, written only when they differ; hidden, not
-    // brought up to date at all (the street's readings would rewrite 500
-    // options for nothing): its tab brings them up to date.
-    let options = Memo::new(move |last: Option<&String>| match last {
-        Some(l) if tab.get() != Tab::Update.slug() => l.clone(),
-        _ => target_options(street, choice),
-    });
+    // The lamps to choose from, listed only while the view is shown (the
+    // street's readings would rewrite 500 options for nothing): its tab
+    // lists them again, the choice made kept.
+    let options = move || match tab.get() == Tab::Update.slug() {
+        true => target_options(street, choice),
+        false => String::new(),
+    };
     let chosen = signal(0u32);
     let choose = move |c: Chosen| {
         CHOSEN.with_borrow_mut(|x| *x = Some(c));
@@ -243,7 +243,7 @@ pub fn UpdateView(tab: RwSignal<String>) -> impl IntoView {
                     "Lamps "
                     {select(
                         "update-targets",
-                        Box::new(move || options.get()),
+                        Box::new(options),
                         Box::new(move |v| choice.set(v)),
                     )}
                 </label>

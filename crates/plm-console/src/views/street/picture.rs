@@ -6,10 +6,10 @@
 //! `data-address`.
 
 use super::{key_address, row_key};
-use crate::fleet::picture::{Cell, Grid, Mark, Picture, WIDTH};
+use crate::fleet::picture::{Cell, Grid, Picture, WIDTH};
 use crate::stores::use_console;
 use crate::views::files;
-use crate::views::widgets::{button, closest, note, on_click, on_event, patch_keyed, signal};
+use crate::views::widgets::{button, closest, note, on_click, on_event, signal};
 use leptos::prelude::*;
 use plm_core::app::Address;
 use plm_core::file::poles::{self, POLE_LIST_MAX};
@@ -39,12 +39,12 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
             )));
         }
     }
-    // Drawn when the fleet, the list or the open lamp changes: of the
-    // heading and the street only what differs (`widgets::patch_keyed`).
+    // Drawn when the fleet, the list or the open lamp changes: the heading
+    // and the street each when it differs.
     Effect::new(move |drawn: Option<Picture>| {
         street.version.track();
         let open = focus.get().map(key_address);
-        let now = list.with(|text| {
+        let mut now = list.with(|text| {
             let poles = (!text.is_empty())
                 .then(|| poles::parse(text.as_bytes()).ok())
                 .flatten();
@@ -61,28 +61,9 @@ pub fn StreetPicture(focus: RwSignal<Option<u64>>) -> impl IntoView {
         if drawn.head != now.head {
             head.set_inner_html(&now.head);
         }
-        let parts = svg.query_selector("svg").ok().flatten().zip(
-            svg.query_selector(".pk-rows")
-                .ok()
-                .flatten()
-                .zip(svg.query_selector(".pk-marks").ok().flatten()),
-        );
-        match parts {
-            Some((frame, (rows, marks))) if !now.view_box.is_empty() => {
-                if drawn.view_box != now.view_box {
-                    let _ = frame.set_attribute("viewBox", &now.view_box);
-                }
-                if drawn.rows != now.rows {
-                    rows.set_inner_html(&now.rows);
-                }
-                let keyed = |m: &[Mark]| -> Vec<(u64, String)> {
-                    m.iter().map(|m| (row_key(m.address), m.html())).collect()
-                };
-                patch_keyed(&marks, &keyed(&drawn.marks), &keyed(&now.marks));
-            }
-            _ => svg.set_inner_html(&now.street()),
+        if drawn.street != now.street {
+            svg.set_inner_html(&now.street);
         }
-        let mut now = now;
         GRID.set(std::mem::take(&mut now.grid));
         now
     });
