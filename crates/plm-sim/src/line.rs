@@ -4,7 +4,7 @@
 //! The seeds give the modulations, bit rates, preamble and unique word
 //! lengths (UM0932 2.1, 3.3.12 Table 35, 4.2.2 Table 54). The rest is a
 //! model, decided here once and written down in docs/protocol-notes.md
-//! ("Simulated power line"): levels in dBµV, a noise floor, per-link
+//! ("Simulated ST7580 and power line", its Levels): levels in dBµV, a noise floor, per-link
 //! attenuation growing with the distance along the street, and an SNR
 //! each modulation needs.
 
