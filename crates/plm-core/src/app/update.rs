@@ -469,16 +469,21 @@ impl Update {
                         _ => None,
                     });
                     if let Some((b, asked)) = asking {
-                        if asked > self.config.repair_rounds {
+                        // At most `repair_rounds` rounds (and a saved
+                        // campaign's count may be anything up to 255).
+                        let next = asked
+                            .checked_add(1)
+                            .filter(|_| asked <= self.config.repair_rounds);
+                        let Some(next) = next else {
                             self.targets[b].state = BoardState::Failed(format!(
                                 "segments still missing after {} repair rounds: the line to this board loses too much",
                                 self.config.repair_rounds
                             ));
                             continue;
-                        }
+                        };
                         self.targets[b].state = BoardState::Receiving {
                             missing: Vec::new(),
-                            asked: asked + 1,
+                            asked: next,
                         };
                         return self.ask(b, Service::RfuStatusGet { campaign });
                     }
