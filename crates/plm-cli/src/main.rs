@@ -427,7 +427,7 @@ fn decode(args: DecodeArgs) -> Result<(), String> {
         Some(Chip::St7580) => Dialect::St7580,
         Some(Chip::St7570) => Dialect::St7570,
         None => {
-            for d in plm_core::decode_app::decode_usart(&bytes) {
+            for d in plm_core::decode::app::decode_usart(&bytes) {
                 print(serde_json::to_string(&d))?;
             }
             return out.flush().map_err(|e| format!("cannot write: {e}"));

@@ -644,7 +644,7 @@ impl StreetSession {
                     }
                 }
                 Happening::Usart { to_board, element } => {
-                    let d = plm_core::decode_app::decode_element(&element);
+                    let d = plm_core::decode::app::decode_element(&element);
                     let from = if to_board { "host" } else { "board" };
                     self.out.sent += to_board as u64;
                     self.out.traffic.push((now, d.to_decoded(from)));

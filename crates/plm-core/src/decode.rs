@@ -26,6 +26,7 @@
 //! power line itself are [`decode_line`]'s ([`LineDecoded`]).
 
 #[cfg(feature = "st7570")]
+pub mod app;
 mod st7570;
 #[cfg(feature = "st7570")]
 mod st7570_line;
@@ -34,12 +35,12 @@ mod st7580;
 #[cfg(feature = "st7570")]
 pub use st7570_line::{decode_line, LineDecoded};
 
-use crate::decode_app::AppDecoded;
 use crate::hex;
 use crate::json::{json_record, Json, Object};
 use crate::link::{Dialect, Element, GarbageReason, LocalFrame, Source, StreamDecoder};
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
+use app::AppDecoded;
 
 /// One decoded element, ready to serialise as a JSON line.
 #[derive(Debug, Clone, PartialEq)]
@@ -105,7 +106,7 @@ json_record!(Decoded {
 });
 
 // An application frame in this decoder's shape lives beside the shape, so
-// that `decode_app`, which `decode` uses for the frames a DL frame carries,
+// that `decode::app`, which `decode` uses for the frames a DL frame carries,
 // uses nothing of `decode`.
 impl AppDecoded {
     /// The same element in the modem decoder's shape, so that one traffic

@@ -1,6 +1,6 @@
 //! A layout's named fields as the members of a JSON object, the way
 //! `plm decode` prints them for a modem's frames ([`crate::decode`]) and a
-//! board's ([`crate::decode_app`]) alike.
+//! board's ([`crate::decode::app`]) alike.
 
 use crate::field::{Field, Value};
 use crate::hex;

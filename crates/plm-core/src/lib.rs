@@ -18,7 +18,7 @@
 //! - [`mib`]: the declarative MIB description (objects, access, defaults).
 //! - [`decode`]: the named-field view of a stream element that `plm decode`
 //!   prints and the console's traffic inspector shows.
-//! - [`decode_app`]: the same view of the controller board's application
+//! - [`decode::app`]: the same view of the controller board's application
 //!   frames, on its USART and on the power line.
 //! - [`file`]: the size cap and the text check of every file read.
 //! - [`json`]: the JSON values, writer and parser those views and the
@@ -47,7 +47,6 @@ pub(crate) type CrcImpl = crc::NoTable;
 pub mod app;
 pub mod chip;
 pub mod decode;
-pub mod decode_app;
 pub mod field;
 mod field_json;
 pub mod file;

@@ -3,7 +3,7 @@
 //! by tests/vectors/make_steval.py from the seed's buffer[] listings, with
 //! frames built independently of plm-core. Each vector is read as the
 //! typed message below, emitted back to the same bytes, and decoded by
-//! `decode_app` as the seed names it.
+//! `decode::app` as the seed names it.
 
 use plm_core::app::crc::{crc16, SEED_TABLE_TYPOS};
 use plm_core::app::hid::{self, Hid};
@@ -12,7 +12,7 @@ use plm_core::app::service::{
     self, Answer, Clock, Discovered, Release, Service, SlotFrame, SlotRead,
 };
 use plm_core::app::{Address, AppFrame, ErrorCode, FrameType, Message};
-use plm_core::decode_app::decode_usart;
+use plm_core::decode::app::decode_usart;
 use serde_json::Value;
 
 const VECTORS: &str = include_str!("../../../tests/vectors/steval_app.jsonl");

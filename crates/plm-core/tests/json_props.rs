@@ -3,8 +3,8 @@
 //! texts accepted and refused, the same values read, and the decoded views
 //! written and read back whole.
 
+use plm_core::decode::app::{decode_usart, AppDecoded};
 use plm_core::decode::{decode_all, Decoded};
-use plm_core::decode_app::{decode_usart, AppDecoded};
 use plm_core::json::{parse, Json, Object};
 use plm_core::link::{Dialect, Source};
 use proptest::collection::vec;

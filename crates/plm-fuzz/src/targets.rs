@@ -6,8 +6,8 @@ use plm_cli::rfc2217::{self, ComPort};
 use plm_core::app::rfu::image;
 use plm_core::app::update::Update;
 use plm_core::app::{AppFrame, LineFrame, Message, UsartDecoder};
+use plm_core::decode::app::{decode_element, decode_usart, AppDecoded};
 use plm_core::decode::{self, Decoded, Decoder, LineDecoded};
-use plm_core::decode_app::{self, AppDecoded};
 use plm_core::file::poles;
 use plm_core::json::{self, Json};
 use plm_core::link::device::DeviceEngine;
@@ -93,14 +93,14 @@ pub fn steval_usart(data: &[u8]) {
         }
         while let Some(e) = usart.next() {
             app_frame(e.bytes());
-            let d = decode_app::decode_element(&e);
+            let d = decode_element(&e);
             let json = d.to_json();
             if let Err(why) = AppDecoded::from_json(&json) {
                 panic!("an exported application element does not import: {why}");
             }
         }
     }
-    let _ = decode_app::decode_usart(data);
+    let _ = decode_usart(data);
 }
 
 /// One application frame (UM 4.3) or line frame: parsed, its message read
@@ -117,7 +117,7 @@ pub fn app_frame(data: &[u8]) {
     }
     let _ = AppFrame::parse_unchecked(data);
     if let Some(line) = LineFrame::parse(data) {
-        let _ = decode_app::decode_line(&line);
+        let _ = decode::app::decode_line_frame(&line);
         let app = line.to_app();
         let _ = Message::of(&app);
         assert_eq!(LineFrame::parse(&line.emit()), Some(line));

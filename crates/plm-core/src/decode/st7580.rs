@@ -1,7 +1,7 @@
 //! The ST7580 side of the decoder (UM0932 3.3-4): the fields of every
 //! command, the status message of Table 8, MIB_ReadConfirm named by the
 //! MIB_ReadRequest before it, and the application frame a DL payload
-//! carries ([`crate::decode_app`]) under `app` in `fields`.
+//! carries ([`crate::decode::app`]) under `app` in `fields`.
 
 use super::{put_hex, Decoded};
 use crate::field_json::put_layout;
@@ -206,7 +206,10 @@ fn put_object(f: &mut Object, index: u8, data: &[u8]) -> Option<String> {
 /// the indication does not give: it shows as the last payload bytes.
 fn put_app(f: &mut Object, payload: &[u8]) {
     if let Some(line) = crate::app::LineFrame::parse(payload) {
-        f.insert("app", crate::decode_app::decode_line(&line).to_json());
+        f.insert(
+            "app",
+            crate::decode::app::decode_line_frame(&line).to_json(),
+        );
     }
 }
 

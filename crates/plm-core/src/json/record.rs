@@ -1,6 +1,6 @@
 //! Structs written as JSON objects, one member per field: what serde's
 //! derive did for [`crate::decode::Decoded`] and
-//! [`crate::decode_app::AppDecoded`], written out once in
+//! [`crate::decode::app::AppDecoded`], written out once in
 //! [`json_record!`].
 
 use super::{Json, Object};

@@ -271,7 +271,7 @@ fn usart_frame(frame: &AppFrame, bytes: &[u8], crc_ok: bool) -> AppDecoded {
 
 /// Decodes a line frame (the DL payload that carries an application frame
 /// over the power line, [`LineFrame`]).
-pub fn decode_line(line: &LineFrame) -> AppDecoded {
+pub fn decode_line_frame(line: &LineFrame) -> AppDecoded {
     let mut d = AppDecoded::new("frame", &line.emit());
     d.destination = Some(line.destination.to_string());
     d.source = Some(line.source.to_string());
@@ -364,7 +364,7 @@ mod tests {
     fn line_frames_name_both_ends_and_have_no_crc() {
         let b = Address([0, 0x80, 0xE1, 0, 0, 1]);
         let line = LineFrame::from_app(&Message::Hid(Hid::Get(hid::ALL)).to(A), b);
-        let d = decode_line(&line);
+        let d = decode_line_frame(&line);
         assert_eq!(d.destination.as_deref(), Some("0080e100002a"));
         assert_eq!(d.source.as_deref(), Some("0080e1000001"));
         assert_eq!(d.address, None);
