@@ -150,7 +150,9 @@ fn SendCard() -> impl IntoView {
 /// A payload as text when it is printable ASCII, else hex.
 fn shown(payload: &[u8]) -> String {
     if !payload.is_empty() && payload.iter().all(|b| (0x20..0x7F).contains(b)) {
-        format!("\"{}\"", String::from_utf8_lossy(payload))
+        // Printable ASCII: each byte is its character (no UTF-8 decoder).
+        let text: String = payload.iter().map(|&b| char::from(b)).collect();
+        format!("\"{text}\"")
     } else {
         super::spaced(&plm_core::hex::encode(payload))
     }
