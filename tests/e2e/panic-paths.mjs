@@ -19,11 +19,15 @@ import { leb } from './short-names.mjs';
 const here = path.dirname(fileURLToPath(import.meta.url));
 const wasmOpt = path.join(here, 'node_modules/.bin/wasm-opt');
 
-/** core's and alloc's functions that only format a panic and panic. */
+/** core's, alloc's and std's functions that only format a panic and panic. */
 const DIVERGING = new RegExp(
-  '^(core|alloc)(\\[[0-9a-f]+\\])?::(' +
+  '^<?(core|alloc|std)(\\[[0-9a-f]+\\])?::(' +
     [
       'panicking::(panic_fmt|panic|panic_bounds_check|assert_failed_inner|panic_const::panic_const_[a-z_]+)',
+      'panicking::assert_failed::<[a-z0-9]+, [a-z0-9]+>',
+      'vec::Vec<_, _>>::(swap_remove|remove|split_off|insert)::assert_failed',
+      'slice::copy_from_slice_impl::len_mismatch_fail',
+      'thread::local::panic_access_error',
       'option::(unwrap_failed|expect_failed)',
       'result::unwrap_failed',
       'str::slice_error_fail(_rt)?',
