@@ -105,7 +105,7 @@ impl ReadAll {
     ) -> (ReadAll, Option<Request>) {
         let mut r = ReadAll {
             config,
-            queue: boards.iter().copied().collect(),
+            queue: boards.to_vec(),
             named: Vec::new(),
             window_ends: None,
             asked: boards.to_vec(),
