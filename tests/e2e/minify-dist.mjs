@@ -2,7 +2,9 @@
 // glue, without the stream classes the wasm no longer exports, and the
 // service worker) with terser, puts the wasm's functions in an order gzip
 // does well with (order-functions.mjs), gives the wasm's imports and
-// exports between it and the glue short names (short-names.mjs), and
+// exports between it and the glue short names (short-names.mjs), ends
+// its panic paths at once (panic-paths.mjs), folds its panic locations
+// into one (panic-locations.mjs), and
 // rewrites the Subresource Integrity hashes index.html gives for them. `cargo xtask dist` runs it
 // after Trunk: the console's 350 KiB budget counts every JS file, and
 // Trunk's own minifier leaves these two as they are. The sources keep
@@ -17,6 +19,8 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { minify } from 'terser';
 import { orderFunctions } from './order-functions.mjs';
+import { foldPanicLocations } from './panic-locations.mjs';
+import { endPanics } from './panic-paths.mjs';
 import { shortenNames } from './short-names.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -52,12 +56,16 @@ for (const name of (await fs.readdir(dist)).filter((f) => f.endsWith('.js')).sor
   const module = wasm !== null;
   if (module) before = dropStreamClasses(before);
   if (wasm) {
-    const short = shortenNames(orderFunctions(wasm), before);
+    const ended = endPanics(wasm);
+    const short = shortenNames(orderFunctions(ended.wasm), before);
+    const folded = foldPanicLocations(short.wasm);
     before = short.js;
-    await fs.writeFile(wasmFile, short.wasm);
+    await fs.writeFile(wasmFile, folded.wasm);
     const oldWasm = sri(wasm);
-    if (html.includes(oldWasm)) html = html.replaceAll(oldWasm, sri(short.wasm));
+    if (html.includes(oldWasm)) html = html.replaceAll(oldWasm, sri(folded.wasm));
     console.log(`minify-dist: ${path.basename(wasmFile)}: ${short.renamed} imports renamed`);
+    console.log(`minify-dist: ${ended.ended.length} panic paths ended at once`);
+    console.log(`minify-dist: ${folded.locations} panic locations folded (${folded.calls} calls), ${folded.names} file names zeroed`);
   }
   const out = await minify(before, { module, compress: true, mangle: true });
   if (out.code === undefined) throw new Error(`${name}: terser produced nothing`);

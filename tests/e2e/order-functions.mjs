@@ -5,7 +5,9 @@
 // neighbours is within gzip's 32 KB window. minify-dist.mjs calls this on
 // a release build, whose wasm-opt run (index.html) keeps the functions'
 // names for it (`-g`); the names are dropped here, as is the target
-// features section, which that run keeps for this one.
+// features section, which that run keeps for this one, and the
+// `__wasm_split_unstable` marker of Leptos's lazy splitting, which the
+// console does not use and no browser reads.
 //
 // The order is given to binaryen's --reorder-functions-by-name as names
 // (each function's rank), so that binaryen renumbers every call, table
@@ -149,8 +151,8 @@ export function orderFunctions(wasm) {
   const body = Buffer.concat([leb(4), Buffer.from('name'), Buffer.from([1]), leb(sub.length), sub]);
   const parts = [wasm.subarray(0, 8)];
   for (const s of sections(wasm)) {
-    const isName = s.id === 0 && reader(wasm, s.start).name() === 'name';
-    if (!isName) parts.push(wasm.subarray(s.head, s.end));
+    const custom = s.id === 0 && reader(wasm, s.start).name();
+    if (custom !== 'name' && custom !== '__wasm_split_unstable') parts.push(wasm.subarray(s.head, s.end));
   }
   parts.push(Buffer.from([0]), leb(body.length), body);
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'order-functions-'));

@@ -206,6 +206,6 @@ fn LinkProblem() -> impl IntoView {
                     problem.set(None);
                 })}
             </div>
-        })}
+        }.into_any())}
     }
 }

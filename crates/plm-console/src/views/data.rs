@@ -315,7 +315,7 @@ fn DataRequestCard() -> impl IntoView {
                 {super::widgets::button("data-send", "Send", "", send)}
             </div>
             <p id="data-result" class:problem=move || problem.get()>
-                {move || result.get()}
+                {move || result.get().unwrap_or_default()}
             </p>
         </article>
     }

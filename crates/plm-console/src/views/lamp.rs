@@ -350,7 +350,7 @@ pub fn LampPanel(focus: RwSignal<Option<u64>>) -> impl IntoView {
                         <div class="form-row">
                             <select on:change=on_event(move |ev| group.set(event_target_value(&ev).parse().unwrap_or(2)))>
                                 {plm_core::app::service::PROG_GROUPS.iter().enumerate().map(|(i, n)| view! {
-                                    <option value=i.to_string() selected=i == 2>{*n}</option>
+                                    <option value=i.to_string() selected=move || i == 2>{*n}</option>
                                 }).map(IntoAny::into_any).collect_view()}
                             </select>
                             {button("", "Read", "", move || ask(Message::Service(Service::ParamGet { group: group.get_untracked() as u8 }), "read parameters"))}

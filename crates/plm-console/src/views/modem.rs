@@ -70,7 +70,7 @@ pub fn ModemView() -> impl IntoView {
     view! {
         <div class="toolbar">
             {button("mib-read-all", "Read all", "", read_all)}
-            <span class="muted" id="mib-progress">{move || progress.get()}</span>
+            <span class="muted" id="mib-progress">{move || progress.get().unwrap_or_default()}</span>
             <Profiles/>
             <span class="muted">
                 {move || String::from(if st7570.get() {
@@ -159,7 +159,7 @@ fn Profiles() -> impl IntoView {
         {move || (running.get()).then(|| view! {
             {button("profile-cancel", "Cancel", "", move || cancel.set(true))}
         }).map(IntoAny::into_any)}
-        <span class="muted" id="profile-message">{move || message.get()}</span>
+        <span class="muted" id="profile-message">{move || message.get().unwrap_or_default()}</span>
     }
 }
 

@@ -128,10 +128,10 @@ fn SendCard() -> impl IntoView {
     view! {
         <article class="card wide" id="sfsk-send">
             <h3>"Send a frame"</h3>
-            <p class="muted">{move || match layer() {
+            <p class="muted">{move || String::from(match layer() {
                 Layer::Mac => "MAC mode: CMD_DataRequest (Table 41) to an address or a group of Table 6, with IC repetitions; a Server of the simulated network answers \"?\" with its address and phase, and echoes anything else.",
                 Layer::Phy => "PHY mode: CMD_DataRequest (Table 40), one 38-byte P_SDU (padded with 00h).",
-            }}</p>
+            })}</p>
             <div class="form-row">
                 <label hidden=phy>"DA "{text_input("sfsk-da", "", "001 or BROADCAST", Some(12), da)}</label>
                 <label hidden=phy>"IC "
@@ -150,7 +150,9 @@ fn SendCard() -> impl IntoView {
 /// A payload as text when it is printable ASCII, else hex.
 fn shown(payload: &[u8]) -> String {
     if !payload.is_empty() && payload.iter().all(|b| (0x20..0x7F).contains(b)) {
-        format!("\"{}\"", String::from_utf8_lossy(payload))
+        // Printable ASCII: each byte is its character (no UTF-8 decoder).
+        let text: String = payload.iter().map(|&b| char::from(b)).collect();
+        format!("\"{text}\"")
     } else {
         super::spaced(&plm_core::hex::encode(payload))
     }

@@ -112,9 +112,9 @@ pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
                         s
                     })
             }}
-            {move || c.traffic.paused_at.get().map(|_| " · PAUSED".to_string())}
+            {move || c.traffic.paused_at.get().map_or(String::new(), |_| " · PAUSED".to_string())}
         </p>
-        {move || message.get().map(|m| view! { <p class="message" id="traffic-message">{m}</p> })}
+        {move || message.get().map(|m| view! { <p class="message" id="traffic-message">{m}</p> }.into_any())}
         <div class="traffic">
             <div
                 class="table-wrap"

@@ -31,7 +31,6 @@ use super::message::Message;
 use super::requester::Request;
 use super::service::{names, Discovered, Service, SlotFrame};
 use crate::time::{Duration, Instant, MS};
-use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
 /// Most slots in one frame: what it hears fits the next request most of
@@ -150,7 +149,7 @@ pub struct Discovery {
     /// Boards heard for the first time in this frame.
     new_in_frame: usize,
     /// Boards heard and not yet named in a request.
-    to_silence: VecDeque<Address>,
+    to_silence: Vec<Address>,
     /// Boards found, in the order they were first heard.
     found: Vec<(Address, Discovered)>,
     done: bool,
@@ -177,7 +176,7 @@ impl Discovery {
             plan: Plan::default(),
             frame_ends: now,
             new_in_frame: 0,
-            to_silence: VecDeque::new(),
+            to_silence: Vec::new(),
             found: known,
             done: false,
         };
@@ -186,7 +185,7 @@ impl Discovery {
     }
 
     fn next_frame(&mut self, now: Instant) -> Request {
-        let named = SlotFrame::fitting(self.to_silence.make_contiguous());
+        let named = SlotFrame::fitting(&self.to_silence);
         let heard: Vec<Address> = self.to_silence.drain(..named).collect();
         self.plan = self
             .estimate
@@ -216,7 +215,7 @@ impl Discovery {
             // Heard again (its silencing was lost, or it restarted): it
             // is named again.
             if !self.to_silence.contains(&address) {
-                self.to_silence.push_back(address);
+                self.to_silence.push(address);
             }
         }
         None

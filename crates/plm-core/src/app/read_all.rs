@@ -15,7 +15,6 @@ use super::message::Message;
 use super::requester::Request;
 use super::service::{names, Service, SlotRead};
 use crate::time::{Instant, MS};
-use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
 /// From a board hearing the request to its first slot, ms: room for its
@@ -84,7 +83,7 @@ impl ReadConfig {
 pub struct ReadAll {
     config: ReadConfig,
     /// Boards not yet named in a request.
-    queue: VecDeque<Address>,
+    queue: Vec<Address>,
     /// Boards named in the request under way, and when its window ends.
     named: Vec<Address>,
     window_ends: Option<Instant>,
@@ -106,7 +105,7 @@ impl ReadAll {
     ) -> (ReadAll, Option<Request>) {
         let mut r = ReadAll {
             config,
-            queue: boards.iter().copied().collect(),
+            queue: boards.to_vec(),
             named: Vec::new(),
             window_ends: None,
             asked: boards.to_vec(),
@@ -118,7 +117,7 @@ impl ReadAll {
     }
 
     fn next(&mut self, now: Instant) -> Option<Request> {
-        let n = SlotRead::fitting(self.queue.make_contiguous());
+        let n = SlotRead::fitting(&self.queue);
         if n == 0 {
             self.named.clear();
             self.window_ends = None;

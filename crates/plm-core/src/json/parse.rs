@@ -64,9 +64,15 @@ impl Parser<'_> {
     }
 
     fn error(&self, expected: &'static str) -> ParseError {
+        // Byte by byte rather than through `matches` and `rsplit`, whose
+        // searchers are 1 KB of the console's wasm for this one use.
         let before = &self.text[..self.pos];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+        let line = before.bytes().filter(|&b| b == b'\n').count() + 1;
+        let start = before
+            .bytes()
+            .rposition(|b| b == b'\n')
+            .map_or(0, |i| i + 1);
+        let column = before[start..].chars().count() + 1;
         let found = match self.text[self.pos..].chars().next() {
             // Control characters and invisible ones (a byte order mark).
             Some(c) if c.is_control() || c == '\u{feff}' => {
