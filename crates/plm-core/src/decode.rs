@@ -25,8 +25,8 @@
 //! `layer`; MIB frames that carry their index). Frames from the ST7570's
 //! power line itself are [`decode_line`]'s ([`LineDecoded`]).
 
-#[cfg(feature = "st7570")]
 pub mod app;
+#[cfg(feature = "st7570")]
 mod st7570;
 #[cfg(feature = "st7570")]
 mod st7570_line;
