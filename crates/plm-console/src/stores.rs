@@ -48,6 +48,8 @@ thread_local! {
     /// When the street's changes were last shown.
     static STREET_SHOWN: std::cell::RefCell<Throttle> =
         const { std::cell::RefCell::new(Throttle::new(STREET_DRAW_US)) };
+    /// Application frames sent to the street and not shown yet.
+    static STREET_SENT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// How long a hardware reset holds RESETN low (DTR asserted). UM0932
@@ -776,15 +778,23 @@ impl Console {
             (s.sweep(), packed, s.now())
         };
         let street = self.street;
-        set_if_changed(street.sweep, sweep);
-        set_if_changed(street.discovering, discovering);
-        if STREET_SHOWN.with_borrow_mut(|t| t.show(changed, page_now_us())) {
+        // The progress, the count sent and the lamps are shown together,
+        // so that what the page says is of one moment.
+        let progress = street.sweep.with_untracked(|s| *s != sweep)
+            || street.discovering.get_untracked() != discovering;
+        let unshown = STREET_SENT.get() + sent;
+        STREET_SENT.set(unshown);
+        let due = changed || progress || sent > 0;
+        if STREET_SHOWN.with_borrow_mut(|t| t.show(due, page_now_us())) {
+            set_if_changed(street.sweep, sweep);
+            set_if_changed(street.discovering, discovering);
+            if unshown > 0 {
+                street.sent.update(|n| *n += unshown);
+                STREET_SENT.set(0);
+            }
             street.now.set(now);
             street.version.update(|v| *v += 1);
             street.keep_history(false);
-        }
-        if sent > 0 {
-            street.sent.update(|n| *n += sent);
         }
         if found {
             let (session, lamps) = self.street.read(|s| s.remembered());
