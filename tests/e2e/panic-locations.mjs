@@ -20,7 +20,7 @@
 // gives it; its bytes are rewritten in place, nothing else moves.
 
 /** Unsigned LEB128 (WebAssembly core spec 5.2.2) from `p`: value, next. */
-function uleb(wasm, p) {
+export function uleb(wasm, p) {
   let v = 0;
   for (let shift = 0; ; shift += 7) {
     const b = wasm[p++];

@@ -15,6 +15,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { leb } from './short-names.mjs';
+import { uleb } from './panic-locations.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const wasmOpt = path.join(here, 'node_modules/.bin/wasm-opt');
@@ -39,16 +40,6 @@ const DIVERGING = new RegExp(
     ].join('|') +
     ')(::h[0-9a-f]{16})?$',
 );
-
-/** Unsigned LEB128 (WebAssembly core spec 5.2.2) from `p`: value, next. */
-function uleb(wasm, p) {
-  let v = 0;
-  for (let shift = 0; ; shift += 7) {
-    const b = wasm[p++];
-    v += (b & 0x7f) * 2 ** shift;
-    if (!(b & 0x80)) return [v, p];
-  }
-}
 
 /** Imported functions and the names of the name section (5.5.2, 7.4.1). */
 function names(wasm) {
