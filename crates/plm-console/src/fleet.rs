@@ -26,7 +26,7 @@ pub const COLUMNS: &[(&str, &str)] = &[
     ("hours", "Hours"),
     ("power_ons", "Power-ons"),
     ("snr", "SNR dB"),
-    ("last_seen", "Last seen s"),
+    ("last_seen", "Last seen"),
 ];
 
 /// A lamp's state at a glance, decided once for the table's colours and
@@ -124,8 +124,12 @@ pub struct Row {
 }
 
 impl Row {
-    /// The row of `lamp`; `now` for how long ago it answered.
-    pub fn of(lamp: &Lamp, now: Instant) -> Row {
+    /// The row of `lamp`, its last answer on the history's clock
+    /// (`epoch` plus the street's: [`crate::history_store::epoch`], the
+    /// plots' clock). A time, not an age: a row changes when its lamp
+    /// answers, not every second, so a redraw of 500 lamps lays out and
+    /// paints the rows read since the last one, not every row in view.
+    pub fn of(lamp: &Lamp, epoch: Instant) -> Row {
         let b = lamp.ballast;
         let watched = lamp.energy.watched() > 0;
         let look = Look::of(lamp);
@@ -159,10 +163,10 @@ impl Row {
                     "energy_watched_s",
                     watched.then(|| (lamp.energy.watched() / 1_000_000) as i64),
                 ),
+                // Seconds since the Unix epoch; a local clock time in a cell.
                 (
                     "last_seen",
-                    lamp.last_seen
-                        .map(|t| (now.saturating_sub(t) / 1_000_000) as i64),
+                    lamp.last_seen.map(|t| ((epoch + t) / 1_000_000) as i64),
                 ),
             ],
         }
@@ -182,6 +186,9 @@ impl Row {
             "address" => self.address.to_string(),
             "firmware" => self.firmware.clone(),
             "state" => self.state.clone(),
+            "last_seen" => self.number(key).map_or_else(String::new, |t| {
+                crate::views::plot::clock_label(t as f64 + crate::views::plot::zone_offset(), 1.0)
+            }),
             k => self.number(k).map(|v| format!("{v}")).unwrap_or_default(),
         }
     }
@@ -285,6 +292,9 @@ mod tests {
     use super::*;
     use plm_core::app::Ballast;
 
+    /// The history's clock at the street's 0: 2026-11-28 12:03:05 UTC.
+    const EPOCH: Instant = 1_795_867_385_000_000;
+
     fn lamp(n: u64, power: u16, status: u16) -> Lamp {
         Lamp {
             address: Address::from_u64(0x0080_e100_0000 + n),
@@ -302,7 +312,7 @@ mod tests {
     fn rows_sort_filter_and_export() {
         let mut rows: Vec<Row> = [lamp(1, 150, 6), lamp(2, 0, 8), lamp(3, 75, 6)]
             .iter()
-            .map(|l| Row::of(l, 11_000_000))
+            .map(|l| Row::of(l, EPOCH))
             .collect();
         sort(&mut rows, "power", true);
         assert_eq!(
@@ -314,17 +324,19 @@ mod tests {
         assert_eq!(rows.iter().filter(|r| r.matches("trouble")).count(), 1);
         let csv = to_csv(&rows);
         let lines: Vec<&str> = csv.split("\r\n").collect();
-        assert_eq!(lines[0], "Address,Firmware,Lamp,Dimming %,Power W,Energy Wh (est.),Bus V,Lamp V,Supply V,Temp °C,Hours,Power-ons,SNR dB,Last seen s");
+        assert_eq!(lines[0], "Address,Firmware,Lamp,Dimming %,Power W,Energy Wh (est.),Bus V,Lamp V,Supply V,Temp °C,Hours,Power-ons,SNR dB,Last seen");
         assert!(
             lines[1].starts_with("0080e1000002,,FAILURE,,0,"),
             "{}",
             lines[1]
         );
         assert!(
-            lines[1].ends_with(",10"),
-            "last seen 10 s ago: {}",
+            lines[1].ends_with(",12:03:06"),
+            "last seen at 12:03:05 plus the 1 s of the street's clock: {}",
             lines[1]
         );
+        let json = to_json(&rows);
+        assert!(json.contains("\"last_seen\": 1795867386"), "{json}");
         let Ok(Json::Array(json)) = json::parse(&to_json(&rows)) else {
             panic!("not a JSON array: {}", to_json(&rows));
         };

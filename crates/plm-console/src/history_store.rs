@@ -215,6 +215,11 @@ pub fn start(id: &str, now: Instant) -> Option<String> {
     problem
 }
 
+/// The history's clock at the street's 0 (µs since the Unix epoch).
+pub fn epoch() -> Instant {
+    STATE.with_borrow(|s| s.epoch)
+}
+
 /// A lamp's readings on the history's clock, oldest first: those kept
 /// from before, then the session's.
 pub fn of(lamp: &Lamp) -> Vec<Sample> {

@@ -179,8 +179,6 @@ pub struct StreetStore {
     pub port: RwSignal<String>,
     /// Application frames sent to the street so far.
     pub sent: RwSignal<u64>,
-    /// The street's clock (µs), for "last seen".
-    pub now: RwSignal<Instant>,
     /// The lamps ticked in the Street view, in the order they were
     /// ticked (the Update view offers them as targets).
     pub selected: RwSignal<Vec<plm_core::app::Address>>,
@@ -311,7 +309,6 @@ pub fn provide_console() -> Console {
             discovering: signal(None),
             port: signal(String::new()),
             sent: signal(0),
-            now: signal(0),
             selected: signal(Vec::new()),
             campaign: signal(0),
             kept_as: signal(String::new()),
@@ -769,13 +766,13 @@ impl Console {
             campaign,
             found,
         } = tick;
-        let (sweep, discovering, now) = {
+        let (sweep, discovering) = {
             let session = self.street.session();
             let s = session.borrow();
             let packed = s
                 .discovering()
                 .map(|(found, left)| ((found as u64) << 32) | left as u64);
-            (s.sweep(), packed, s.now())
+            (s.sweep(), packed)
         };
         let street = self.street;
         // The progress, the count sent and the lamps are shown together,
@@ -792,7 +789,6 @@ impl Console {
                 street.sent.update(|n| *n += unshown);
                 STREET_SENT.set(0);
             }
-            street.now.set(now);
             street.version.update(|v| *v += 1);
             street.keep_history(false);
         }

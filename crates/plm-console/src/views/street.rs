@@ -33,9 +33,9 @@ pub fn StreetView() -> impl IntoView {
     // The rows shown, sorted and filtered.
     let rows = Memo::new(move |_| {
         street.version.track();
-        let now = street.now.get();
+        let epoch = crate::history_store::epoch();
         let mut rows: Vec<Row> =
-            street.with_fleet(|f| f.values().map(|l| Row::of(l, now)).collect());
+            street.with_fleet(|f| f.values().map(|l| Row::of(l, epoch)).collect());
         sort.with(|s| match s.strip_prefix('-') {
             Some(key) => fleet::sort(&mut rows, key, false),
             None => fleet::sort(&mut rows, s, true),
