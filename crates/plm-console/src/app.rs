@@ -134,7 +134,7 @@ pub fn App() -> impl IntoView {
                     <NetworkView/>
                 </Panel>
                 <Panel tab=tab which=Tab::Simulator>
-                    <SimulatorView/>
+                    <SimulatorView tab=tab/>
                 </Panel>
             </main>
             <LinkProblem/>

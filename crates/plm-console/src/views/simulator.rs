@@ -11,7 +11,7 @@ use plm_sim::{ByteFaults, Dir, Fault, LineConfig};
 
 /// The view.
 #[component]
-pub fn SimulatorView() -> impl IntoView {
+pub fn SimulatorView(tab: RwSignal<String>) -> impl IntoView {
     let profile = use_console().profile;
     view! {
         <div class="cards">
@@ -22,7 +22,7 @@ pub fn SimulatorView() -> impl IntoView {
             <ModemFaultsCard/>
             <LineCard/>
             <UartCard/>
-            <LineEventsCard/>
+            <LineEventsCard tab=tab/>
         </div>
     }
 }
@@ -325,12 +325,15 @@ fn UartCard() -> impl IntoView {
 }
 
 #[component]
-fn LineEventsCard() -> impl IntoView {
+fn LineEventsCard(tab: RwSignal<String>) -> impl IntoView {
     let c = use_console();
+    // Written only while the view is shown: on a street every frame on the
+    // line is an event, and the list would be written again for nothing.
+    let shown = move || tab.with(|t| t == crate::tab::Tab::Simulator.slug());
     view! {
         <article class="card wide" id="sim-events">
             <h3>"On the power line"</h3>
-            {move || {
+            {move || shown().then(|| {
                 let events = c.sim.line_events.get();
                 if events.is_empty() {
                     view! {
@@ -348,7 +351,7 @@ fn LineEventsCard() -> impl IntoView {
                     }
                         .into_any()
                 }
-            }}
+            })}
         </article>
     }
 }

@@ -510,12 +510,21 @@ pub mod names {
     /// How many of `list`, from its start, fit in a request whose other
     /// data takes `fixed` bytes (the frame's 100-byte payload, its
     /// command byte included), and no more than `most`.
+    /// One pass: each address taken can only shorten the shared prefix,
+    /// and adds at least a byte (every board of a street checks each
+    /// slotted request it hears).
     pub fn fitting(list: &[Address], fixed: usize, most: usize) -> usize {
         let room = MAX_PAYLOAD - 1 - fixed;
-        (0..=list.len().min(most))
-            .take_while(|k| len(&list[..*k]) <= room)
-            .last()
-            .unwrap_or(0)
+        let mut p = 5;
+        let mut fit = 0;
+        for (k, a) in list.iter().take(most).enumerate() {
+            p = shared(&[list[0], *a]).min(p);
+            if 1 + p + (k + 1) * (6 - p) > room {
+                break;
+            }
+            fit = k + 1;
+        }
+        fit
     }
 
     /// Appends `list` to `out`.
@@ -1131,6 +1140,43 @@ mod tests {
     use super::*;
 
     use alloc::string::ToString;
+
+    #[test]
+    fn the_addresses_fitting_a_request_are_the_most_whose_list_fits() {
+        // Streets sharing 0 to 5 bytes, one address breaking the prefix
+        // at different places, and every limit.
+        let mut x = 0x2545_f491_u64;
+        for shared_bytes in 0..=5usize {
+            for breaker in [None, Some(0), Some(3), Some(17)] {
+                let list: Vec<Address> = (0..40u64)
+                    .map(|i| {
+                        x = x
+                            .wrapping_mul(6364136223846793005)
+                            .wrapping_add(1442695040888963407);
+                        let mut a = [0x00, 0x80, 0xe1, 0x12, 0x34, 0x56];
+                        let tail = (x >> 16).to_be_bytes();
+                        a[shared_bytes..].copy_from_slice(&tail[2 + shared_bytes..]);
+                        if breaker == Some(i as usize) {
+                            a[0] ^= 0xff;
+                        }
+                        Address(a)
+                    })
+                    .collect();
+                for (fixed, most) in [(0, usize::MAX), (4, 16), (13, 10), (90, usize::MAX)] {
+                    let room = crate::app::frame::MAX_PAYLOAD - 1 - fixed;
+                    let brute = (0..=list.len().min(most))
+                        .filter(|k| names::len(&list[..*k]) <= room)
+                        .max()
+                        .unwrap_or(0);
+                    assert_eq!(
+                        names::fitting(&list, fixed, most),
+                        brute,
+                        "{shared_bytes} {breaker:?} {fixed} {most}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn requests_and_replies_of_one_command_are_told_apart_by_length() {
