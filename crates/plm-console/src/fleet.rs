@@ -187,7 +187,7 @@ impl Row {
             "firmware" => self.firmware.clone(),
             "state" => self.state.clone(),
             "last_seen" => self.number(key).map_or_else(String::new, |t| {
-                crate::views::plot::clock_label(t as f64 + crate::views::plot::zone_offset(), 1.0)
+                crate::numbers::clock_label(t as f64 + crate::numbers::zone_offset(), 1.0)
             }),
             k => self.number(k).map(|v| format!("{v}")).unwrap_or_default(),
         }

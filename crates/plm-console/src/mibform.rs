@@ -4,10 +4,7 @@
 //! the chip would check it before anything is sent. No object has a form
 //! of its own: the Modem view renders every one from this.
 
-use plm_core::chip::Chip;
 use plm_core::field::{Field, Kind};
-use plm_core::json::{self, Json};
-use plm_core::link::Dialect;
 use plm_core::mib::Object;
 
 /// Texts by field name: what a form's inputs hold, or what is wrong with
@@ -225,20 +222,6 @@ pub fn build(object: &'static Object, base: &[u8], inputs: &Texts) -> Result<Vec
     }
 }
 
-/// What a saved profile file says it is.
-pub const PROFILE_FORMAT: &str = "plm-console MIB profile";
-
-/// The objects a profile holds: those written with their value (not the
-/// counters a write resets, ST7570 UM 6.5).
-fn in_profile(o: &&Object) -> bool {
-    o.access.write && o.write.is_none()
-}
-
-/// The objects of `chip` a profile holds.
-pub fn profile_objects(chip: &dyn Chip) -> impl Iterator<Item = &'static Object> {
-    chip.mib().iter().filter(in_profile)
-}
-
 /// Whether a write of `object` resets it rather than setting the value
 /// the form shows (ST7570 UM 6.5: a counter is reset by PAD bytes).
 pub fn write_resets(object: &Object) -> bool {
@@ -258,75 +241,6 @@ pub fn write_data(object: &Object, value: &[u8]) -> Vec<u8> {
         Some(_) if write_resets(object) => vec![0; object.write_len()],
         Some(_) => value[..object.write_len().min(value.len())].to_vec(),
     }
-}
-
-/// A MIB index as profiles and messages write it: two hex digits for the
-/// ST7580's one-byte indexes (UM0932 Table 52), four for the ST7570's
-/// (`00A1`, ST7570 UM 6.5).
-pub fn index_text(dialect: Dialect, index: u16) -> String {
-    match dialect {
-        Dialect::St7580 => format!("{index:02X}"),
-        _ => format!("{index:04X}"),
-    }
-}
-
-/// A configuration profile of `chip`: values of its writable MIB objects,
-/// saved to and loaded from a JSON file (`{"format":…, "chip":"ST7580",
-/// "objects": {"01": "014ff0…"}}`, values as lowercase hex).
-pub fn profile_json(chip: &dyn Chip, values: &MibValues) -> String {
-    let mut objects = json::Object::new();
-    for o in chip.mib().iter().filter(in_profile) {
-        if let Some(v) = values.get(&o.index) {
-            objects.insert(
-                index_text(chip.dialect(), o.index).to_ascii_lowercase(),
-                Json::String(plm_core::hex::encode(v)),
-            );
-        }
-    }
-    let mut profile = json::Object::new();
-    profile.insert("format", Json::from(PROFILE_FORMAT));
-    profile.insert("chip", Json::from(chip.name()));
-    profile.insert("objects", Json::Object(objects));
-    Json::Object(profile).pretty()
-}
-
-/// Reads a profile file for `chip`; every value is checked as a MIB write
-/// request would be, and the first problem refuses the whole file.
-pub fn parse_profile(chip: &dyn Chip, text: &str) -> Result<Vec<(u16, Vec<u8>)>, String> {
-    let v = json::parse(text).map_err(|e| format!("not JSON ({e})"))?;
-    if v.get("format").and_then(Json::as_str) != Some(PROFILE_FORMAT) {
-        return Err(format!(
-            "not a profile: \"format\" must be \"{PROFILE_FORMAT}\""
-        ));
-    }
-    let name = chip.name();
-    if v.get("chip").and_then(Json::as_str) != Some(name) {
-        return Err(format!("the profile is not for the {name}"));
-    }
-    let objects = v
-        .get("objects")
-        .and_then(Json::as_object)
-        .ok_or("the profile has no \"objects\"")?;
-    let mut out = Vec::new();
-    for (key, value) in objects {
-        let index = u16::from_str_radix(key, 16)
-            .map_err(|_| format!("\"{key}\" is not a MIB index in hex"))?;
-        let hex = value
-            .as_str()
-            .ok_or_else(|| format!("object {key}: the value must be a hex string"))?;
-        let data = plm_core::hex::parse(hex).map_err(|e| format!("object {key}: {e}"))?;
-        let at = index_text(chip.dialect(), index);
-        let o = plm_core::chip::object(chip, index)
-            .filter(in_profile)
-            .ok_or_else(|| format!("object {at}h: not a writable object of the {name}"))?;
-        o.check_write(&data)
-            .map_err(|e| format!("object {at}h: {e}"))?;
-        out.push((index, data));
-    }
-    if out.is_empty() {
-        return Err("the profile has no objects".to_string());
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
@@ -395,93 +309,5 @@ mod tests {
         let mc = object(index::MODEM_CONFIG).unwrap();
         let p = build(mc, &[0x31], &inputs(mc, &[0x31])).unwrap_err();
         assert_eq!(p.fields["reserved"], "Reserved bits must be 0, not 1");
-    }
-
-    #[test]
-    fn profiles_save_writable_objects_and_load_them_checked() {
-        let chip = plm_core::chip::St7580::default();
-        let phy = index::PHY_CONFIG as u16;
-        let mut values = MibValues::default();
-        values.insert(phy, object(index::PHY_CONFIG).unwrap().default.to_vec());
-        values.insert(index::FIRMWARE_VERSION as u16, vec![0, 0x42, 0, 0x97]);
-        let text = profile_json(&chip, &values);
-        assert!(text.contains("\"01\": \"014ff0"), "{text}");
-        let back = parse_profile(&chip, &text).unwrap();
-        assert_eq!(back, [(phy, values[&phy].clone())]);
-        let bad = text.replace("014ff0", "030d40");
-        assert_eq!(
-            parse_profile(&chip, &bad),
-            Err("object 01h: high_frequency: 200000 is out of range: 3000 to 148500 Hz".into())
-        );
-        assert!(parse_profile(&chip, "{}")
-            .unwrap_err()
-            .starts_with("not a profile"));
-    }
-
-    /// A profile cut short, with a byte changed anywhere, or not UTF-8
-    /// text, is refused in words (or, changed where the value stays
-    /// valid, read and checked as any profile), never a panic.
-    #[test]
-    fn a_damaged_profile_is_refused_in_words() {
-        let chip = plm_core::chip::St7580::default();
-        let mut values = MibValues::default();
-        for i in [index::PHY_CONFIG, index::MODEM_CONFIG] {
-            values.insert(i as u16, object(i).unwrap().default.to_vec());
-        }
-        let text = profile_json(&chip, &values).into_bytes();
-        let read = |b: &[u8]| plm_core::file::text(b).and_then(|t| parse_profile(&chip, t));
-        assert!(read(&text).is_ok());
-        for n in 0..text.len() {
-            assert!(read(&text[..n]).unwrap_err().len() > 15, "cut at {n}");
-        }
-        for i in 0..text.len() {
-            for bit in [0x01, 0x20, 0x80] {
-                let mut b = text.clone();
-                b[i] ^= bit;
-                if let Err(why) = read(&b) {
-                    assert!(why.len() > 15, "{why}");
-                }
-            }
-        }
-        let utf16: Vec<u8> = text.iter().flat_map(|&b| [b, 0]).collect();
-        assert!(read(&[&[0xFE, 0xFF][..], &utf16].concat())
-            .unwrap_err()
-            .contains("UTF-16"));
-        assert!(read(&utf16).unwrap_err().contains("NUL byte"));
-    }
-
-    /// Issue 12: the ST7570's profile files come from the same code, read
-    /// its MIB (16-bit indexes, Table 71), leave out the counters a write
-    /// resets, and refuse a profile of the other chip.
-    #[test]
-    fn an_st7570_profile_holds_its_configuration_objects_only() {
-        use plm_core::st7570::mib::{index as i7570, object as o7570};
-        let chip = plm_core::chip::St7570::default();
-        let mut values = MibValues::default();
-        for o in chip.mib() {
-            values.insert(o.index, o.default.to_vec());
-        }
-        let text = profile_json(&chip, &values);
-        assert!(text.contains("\"chip\": \"ST7570\""), "{text}");
-        assert!(text.contains("\"00a1\": "), "{text}");
-        let back = parse_profile(&chip, &text).unwrap();
-        assert!(back.iter().all(|(i, _)| {
-            let o = o7570(*i).unwrap();
-            o.access.write && !write_resets(o)
-        }));
-        assert!(back.iter().any(|(i, _)| *i == i7570::PLC_CONFIGURATION));
-        assert!(parse_profile(&plm_core::chip::St7580::default(), &text)
-            .unwrap_err()
-            .contains("not for the ST7580"));
-        // A value the chip would refuse refuses the whole file.
-        let tic = o7570(i7570::TIC_REPEATER).unwrap();
-        let bad = text.replace(
-            &format!("\"000b\": \"{}\"", plm_core::hex::encode(tic.default)),
-            "\"000b\": \"0102\"",
-        );
-        assert_ne!(bad, text);
-        assert!(parse_profile(&chip, &bad)
-            .unwrap_err()
-            .starts_with("object 000Bh:"));
     }
 }

@@ -72,6 +72,36 @@ pub fn spaced(hex: &str) -> String {
     s
 }
 
+/// Seconds in a day.
+pub const DAY: f64 = 86_400.0;
+
+/// A local clock time as `HH:MM:SS`, or `HH:MM` when `step` is whole
+/// minutes.
+pub fn clock_label(t: f64, step: f64) -> String {
+    let s = (t.floor() as i64).rem_euclid(DAY as i64);
+    let hm = format!("{:02}:{:02}", s / 3600, s / 60 % 60);
+    // Whole minutes, tested without `%` on floats (libm's fmod and the
+    // 128-bit division under it, 2 KB of the page's code for this test).
+    if step >= 60.0 && (step / 60.0).trunc() * 60.0 == step {
+        hm
+    } else {
+        format!("{hm}:{:02}", s % 60)
+    }
+}
+
+/// Seconds to add to a time since the Unix epoch for this computer's
+/// local clock (0 natively: the tests' clock is UTC).
+pub fn zone_offset() -> f64 {
+    #[cfg(target_arch = "wasm32")]
+    {
+        -js_sys::Date::new_0().get_timezone_offset() * 60.0
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        0.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

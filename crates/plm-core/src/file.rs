@@ -11,9 +11,11 @@
 //! bytes that are not UTF-8 and NUL bytes are refused, each in words that
 //! say where.
 //!
-//! [`poles`]: the pole list, which lamp stands where along the street.
+//! [`poles`]: the pole list, which lamp stands where along the street;
+//! [`profile`]: a MIB configuration profile.
 
 pub mod poles;
+pub mod profile;
 
 use alloc::format;
 use alloc::string::String;

@@ -7,8 +7,10 @@ use plm_core::app::frame::Address;
 use plm_core::app::service::Release;
 use plm_core::app::update::{Update, UpdateConfig};
 use plm_core::app::{AppFrame, LineFrame};
+use plm_core::chip::{Chip, St7570, St7580};
 use plm_core::decode::app::decode_usart;
 use plm_core::decode::{decode_all, decode_line};
+use plm_core::file::profile;
 use plm_core::json::{self, Json};
 use plm_core::link::{Dialect, Source};
 use std::path::Path;
@@ -127,6 +129,12 @@ pub fn all(root: &Path) -> Result<Vec<Seed>, String> {
     for (i, chunk) in json_lines.chunks(16).enumerate() {
         let text = chunk.join("\n") + "\n";
         seeds.push(("json_lines", format!("decoded-{i}"), text.into_bytes()));
+    }
+    // Each chip's MIB profile of its defaults, as the Modem view saves it.
+    for chip in [&St7580::default() as &dyn Chip, &St7570::default()] {
+        let text = profile::to_json(chip, |i| plm_core::chip::object(chip, i).map(|o| o.default));
+        let name = format!("profile-{}", chip.name());
+        seeds.push(("json_lines", name, text.into_bytes()));
     }
     for (size, release) in [(512, (1, 0)), (2048, (1, 4)), (8192, (2, 11))] {
         let (major, minor) = release;

@@ -6,9 +6,10 @@ use plm_cli::rfc2217::{self, ComPort};
 use plm_core::app::rfu::image;
 use plm_core::app::update::Update;
 use plm_core::app::{AppFrame, LineFrame, Message, UsartDecoder};
+use plm_core::chip::{Chip, St7570, St7580};
 use plm_core::decode::app::{decode_element, decode_usart, AppDecoded};
 use plm_core::decode::{self, Decoded, Decoder, LineDecoded};
-use plm_core::file::poles;
+use plm_core::file::{poles, profile};
 use plm_core::json::{self, Json};
 use plm_core::link::device::DeviceEngine;
 use plm_core::link::host::{HostConfig, HostEngine};
@@ -143,13 +144,24 @@ pub fn st7570_mac(data: &[u8]) {
     }
 }
 
-/// A JSON Lines file (a traffic log, `plm decode` output, a profile): the
-/// file's text, each line and the whole as JSON, each value read as every
-/// kind of element. A parsed value prints and parses back to itself.
+/// A JSON Lines file (a traffic log, `plm decode` output) or a MIB
+/// profile: the file's text, each line and the whole as JSON, each value
+/// read as every kind of element, the whole as either chip's profile. A
+/// parsed value prints and parses back to itself; a profile read saves as
+/// one that reads back.
 pub fn json_lines(data: &[u8]) {
     let Ok(text) = plm_core::file::text(data) else {
         return;
     };
+    for chip in [&St7580::default() as &dyn Chip, &St7570::default()] {
+        if let Ok(values) = profile::parse(chip, text) {
+            let saved = profile::to_json(chip, |i| {
+                values.iter().find(|(x, _)| *x == i).map(|(_, v)| &v[..])
+            });
+            let again = profile::parse(chip, &saved).expect("a saved profile reads back");
+            assert!(again.iter().all(|v| values.contains(v)), "{saved}");
+        }
+    }
     let whole = json::parse(text);
     for line in text.lines().chain(whole.is_ok().then_some(text)) {
         let Ok(v) = json::parse(line) else {

@@ -12,6 +12,7 @@ use crate::mibform;
 use crate::stores::use_console;
 use leptos::prelude::*;
 use plm_core::field::Kind;
+use plm_core::file::profile;
 use plm_core::link::Dialect;
 use plm_core::mib::Object;
 use plm_core::st7580::mib::index;
@@ -106,8 +107,7 @@ fn Profiles() -> impl IntoView {
     let cancel = signal(false);
     let save = move || {
         let values = c.modem.mib.get_untracked();
-        let writable: Vec<u16> =
-            c.with_chip(|ch| mibform::profile_objects(ch).map(|o| o.index).collect());
+        let writable: Vec<u16> = c.with_chip(|ch| profile::objects(ch).map(|o| o.index).collect());
         let have = writable.iter().filter(|i| values.contains_key(i)).count();
         if have == 0 {
             message.set(Some(
@@ -115,7 +115,7 @@ fn Profiles() -> impl IntoView {
             ));
             return;
         }
-        let text = c.with_chip(|ch| mibform::profile_json(ch, &values));
+        let text = c.with_chip(|ch| profile::to_json(ch, |i| values.get(&i).map(|v| &v[..])));
         message.set(Some(
             match files::download("plm-profile.json", "application/json", &text) {
                 Ok(()) if have == writable.len() => {
@@ -137,7 +137,7 @@ fn Profiles() -> impl IntoView {
             let name = file.name();
             let list = match files::read_text(&file)
                 .await
-                .and_then(|t| c.with_chip(|ch| mibform::parse_profile(ch, &t)))
+                .and_then(|t| c.with_chip(|ch| profile::parse(ch, &t)))
             {
                 Ok(list) => list,
                 Err(e) => {
@@ -186,7 +186,7 @@ fn apply_profile(
         )));
         return;
     };
-    let at = c.with_chip(|ch| mibform::index_text(ch.dialect(), index));
+    let at = c.with_chip(|ch| profile::index_text(ch.dialect(), index));
     message.set(Some(format!("Writing {} of {n} ({at}h)…", i + 1)));
     c.write_mib(index, data, move |r| match r {
         Ok(_) => c.read_mib(index, move |_| {
@@ -305,7 +305,7 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
         status.set("factory default loaded into the form: Write to send it".into());
     };
     view! {
-        <article class="card mib" id=format!("mib-{}", mibform::index_text(dialect, idx).to_ascii_lowercase())>
+        <article class="card mib" id=format!("mib-{}", profile::index_text(dialect, idx).to_ascii_lowercase())>
             <header inner_html=header_html(object, dialect)></header>
             // The actions as HTML, their clicks handled by one listener
             // by the `data-action` clicked.
@@ -346,7 +346,7 @@ fn MibCard(object: &'static Object, dialect: Dialect) -> impl IntoView {
 fn header_html(object: &'static Object, dialect: Dialect) -> String {
     format!(
         "<h3><span class=\"index\">{}h</span> {}</h3><span class=\"access\" title=\"Access\">{}</span><span class=\"muted\">{}</span>",
-        mibform::index_text(dialect, object.index),
+        profile::index_text(dialect, object.index),
         escape(object.name),
         escape(object.access.label()),
         escape(object.section)

@@ -119,7 +119,8 @@ const CLOCK_STEPS: [f64; 17] = [
     1.0, 2.0, 5.0, 10.0, 15.0, 30.0, 60.0, 120.0, 300.0, 600.0, 900.0, 1800.0, 3600.0, 7200.0,
     10800.0, 21600.0, 43200.0,
 ];
-const DAY: f64 = 86_400.0;
+use crate::numbers::DAY;
+pub use crate::numbers::{clock_label, zone_offset};
 
 /// A time axis in seconds of a local clock (seconds since the Unix epoch
 /// plus the time zone's offset) from `t0` to `t1` (one reading gets a
@@ -145,33 +146,6 @@ pub fn clock_axis(t0: f64, t1: f64, intervals: f64) -> Axis {
         hi: t1,
         step,
         ticks: (first..=last).map(|i| i as f64 * step).collect(),
-    }
-}
-
-/// A local clock time as `HH:MM:SS`, or `HH:MM` when `step` is whole
-/// minutes.
-pub fn clock_label(t: f64, step: f64) -> String {
-    let s = (t.floor() as i64).rem_euclid(DAY as i64);
-    let hm = format!("{:02}:{:02}", s / 3600, s / 60 % 60);
-    // Whole minutes, tested without `%` on floats (libm's fmod and the
-    // 128-bit division under it, 2 KB of the page's code for this test).
-    if step >= 60.0 && (step / 60.0).trunc() * 60.0 == step {
-        hm
-    } else {
-        format!("{hm}:{:02}", s % 60)
-    }
-}
-
-/// Seconds to add to a time since the Unix epoch for this computer's
-/// local clock (0 natively: the tests' clock is UTC).
-pub fn zone_offset() -> f64 {
-    #[cfg(target_arch = "wasm32")]
-    {
-        -js_sys::Date::new_0().get_timezone_offset() * 60.0
-    }
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        0.0
     }
 }
 
