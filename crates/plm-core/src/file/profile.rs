@@ -110,9 +110,10 @@ mod tests {
     fn profiles_save_writable_objects_and_load_them_checked() {
         let chip = crate::chip::St7580::default();
         let phy = index::PHY_CONFIG as u16;
-        let mut values: Vec<(u16, Vec<u8>)> = Vec::new();
-        values.push((phy, object(index::PHY_CONFIG).unwrap().default.to_vec()));
-        values.push((index::FIRMWARE_VERSION as u16, vec![0, 0x42, 0, 0x97]));
+        let values = vec![
+            (phy, object(index::PHY_CONFIG).unwrap().default.to_vec()),
+            (index::FIRMWARE_VERSION as u16, vec![0, 0x42, 0, 0x97]),
+        ];
         let text = text_of(&chip, &values);
         assert!(text.contains("\"01\": \"014ff0"), "{text}");
         let back = parse(&chip, &text).unwrap();
