@@ -312,12 +312,10 @@ fn sweep(lamps: usize, step: usize) {
         let took = at.elapsed().as_secs_f64();
         let s = (d.now() - start) as f64 / 1e6;
         speeds.push(s / took);
-        (reads, failed, simulated, wall) = (
-            reads + replies.len(),
-            failed + lost,
-            simulated + s,
-            wall + took,
-        );
+        reads += replies.len();
+        failed += lost;
+        simulated += s;
+        wall += took;
     }
     speeds.sort_by(f64::total_cmp);
     let speed = speeds[SWEEPS / 2];
