@@ -23,7 +23,8 @@
 //!   wallS}`: a simulated street's speed in the page.
 
 use crate::clock::page_now_us;
-use crate::session::{Outcome, Spread};
+use crate::driver::ack::Spread;
+use crate::session::Outcome;
 use crate::stores::Console;
 use js_sys::{Function, Object, Promise, Reflect};
 use leptos::prelude::GetUntracked;

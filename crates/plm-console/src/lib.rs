@@ -20,6 +20,7 @@
 static ALLOCATOR: talc::wasm::WasmDynamicTalc = talc::wasm::new_wasm_dynamic_allocator();
 
 pub mod clock;
+pub mod driver;
 pub mod fleet;
 pub mod line_events;
 pub mod long_table;

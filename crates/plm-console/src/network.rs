@@ -485,7 +485,8 @@ mod tests {
     /// Runs `s` for `ms` of the page's clock, feeding `log` as the
     /// console's stores do.
     fn drive(s: &mut crate::session::Session, log: &mut NetworkLog, page: &mut f64, ms: u32) {
-        use crate::session::{Budget, Note};
+        use crate::driver::Budget;
+        use crate::session::Note;
         for _ in 0..ms / 4 {
             *page += 4_000.0;
             let t = s.tick(*page, Budget::UNLIMITED);

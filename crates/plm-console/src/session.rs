@@ -21,41 +21,16 @@
 //!   ([`AckLatency`]): from the arrival of the frame's last byte to the
 //!   ACK written, against T_ACK (UM0932 3.2.8).
 
+use crate::driver::ack::AckLatency;
+use crate::driver::{self, earliest, Budget, Driver, Layer};
 use crate::transport::{LinkState, Transport};
 use plm_core::chip::{self, Chip};
 use plm_core::decode::Decoded;
-use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
+use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket};
 use plm_core::link::{Dialect, Element, LocalFrame, Source, StatusMessage, Timeouts};
 use plm_core::time::{Duration, Instant, MS};
 use std::collections::VecDeque;
 
-/// Longest step of the transport's time between two looks at the engine:
-/// the host answers a modem frame at most this late (T_ACK is 40 ms).
-pub const SLICE: Duration = MS;
-/// How far the transport's time may be behind the page's clock before the
-/// difference is given up: after the page was busy or hidden the
-/// simulated world slows down rather than fast-forwarding.
-pub const MAX_CATCH_UP: Duration = 100 * MS;
-/// The same for the simulated modem (less than one exchange), whose time
-/// otherwise replays a stall of the page frame by frame with a host that
-/// answers at once: every frame of the replay counted the page's lag as
-/// ACK latency again (issue 13: after a 35 ms stall, seven ACKs from 35
-/// ms down by 5 ms). A real modem sees one late ACK and carries on from
-/// there, as this does.
-pub const SIM_CATCH_UP: Duration = 4 * MS;
-/// How far `transport`'s time may trail the page's clock: a simulated
-/// modem of either chip ([`SIM_CATCH_UP`]), a real port ([`MAX_CATCH_UP`]).
-pub fn catch_up(transport: &dyn Transport) -> Duration {
-    match transport.kind() {
-        "Simulated" => SIM_CATCH_UP,
-        _ => MAX_CATCH_UP,
-    }
-}
-/// How long one tick may keep the page busy, µs of the page's clock: past
-/// it the transport's time stops short of the page's and catches up at the
-/// next tick, so a simulated world the page cannot run in real time (a long
-/// street during discovery) slows down instead of freezing the page.
-pub const TICK_BUDGET_US: f64 = 12_000.0;
 /// How often the notes of what happened are handed out, µs of the page's
 /// clock: about one screen refresh.
 pub const SHOW_EVERY: f64 = 16_000.0;
@@ -72,103 +47,6 @@ pub const EXCHANGE_ELEMENTS: usize = 5;
 /// How long after its answer a request repeated for want of an ACK may
 /// still see a second answer.
 pub const DUPLICATE_GRACE: Duration = 200 * MS;
-/// ACK latencies kept for the percentiles (the most recent ones).
-pub const ACK_SAMPLES: usize = 1_000;
-
-/// Maps the page's clock onto a transport's clock: the transport's time
-/// follows the page's (`speed` times as fast, for a simulated world; 1
-/// when 0), but never more than [`MAX_CATCH_UP`] at once.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Pacer {
-    /// Page time (µs) at which the transport's clock read 0.
-    origin: Option<f64>,
-    /// The page's clock on the transport's clock at the last call.
-    page_now: Instant,
-    /// How much faster than the page's clock (0: as fast).
-    pub speed: u32,
-}
-
-impl Pacer {
-    /// Where the transport's time, now at `start`, should run to when the
-    /// page's clock reads `page_us`.
-    pub fn target(&mut self, page_us: f64, start: Instant) -> Instant {
-        self.target_within(page_us, start, MAX_CATCH_UP, Some(start))
-    }
-
-    /// [`Pacer::target`], giving up a lag past `catch_up` behind `busy`,
-    /// the transport's next event (a byte due, a timeout; `None`: none).
-    /// Until then nothing happens behind the transport, so that time
-    /// passes whole: an idle world is not late, and a request made after
-    /// an idle while leaves when the page asked for it, not a catch-up
-    /// limit after the world's last event.
-    pub fn target_within(
-        &mut self,
-        page_us: f64,
-        start: Instant,
-        catch_up: Duration,
-        busy: Option<Instant>,
-    ) -> Instant {
-        let speed = self.speed.max(1) as f64;
-        let origin = *self.origin.get_or_insert(page_us - start as f64 / speed);
-        let target = ((page_us - origin) * speed).max(0.0) as Instant;
-        self.page_now = target;
-        let Some(limit) = busy.map(|b| b.max(start) + catch_up) else {
-            return target;
-        };
-        if target > limit {
-            self.origin = Some(page_us - limit as f64 / speed);
-            return limit;
-        }
-        target
-    }
-
-    /// The page's clock on the transport's clock at the last call (before
-    /// any catch-up limit).
-    pub fn page_now(&self) -> Instant {
-        self.page_now
-    }
-
-    /// When the page's clock reaches the transport's instant `t` (µs of
-    /// the page's clock), as the last call mapped them.
-    pub fn page_at(&self, t: Instant) -> Option<f64> {
-        let speed = self.speed.max(1) as f64;
-        self.origin.map(|o| o + t as f64 / speed)
-    }
-}
-
-/// The earliest of some instants.
-pub fn earliest(times: impl IntoIterator<Item = Option<Instant>>) -> Option<Instant> {
-    times.into_iter().flatten().min()
-}
-
-/// When a tick must hand the page back (see [`TICK_BUDGET_US`]).
-#[derive(Debug, Clone, Copy)]
-pub struct Budget {
-    clock: Option<fn() -> f64>,
-    until: f64,
-}
-
-impl Budget {
-    /// No limit: tests, and time that must pass whole.
-    pub const UNLIMITED: Budget = Budget {
-        clock: None,
-        until: f64::INFINITY,
-    };
-
-    /// `us` from now on `clock` (µs).
-    pub fn wall(clock: fn() -> f64, us: f64) -> Budget {
-        Budget {
-            clock: Some(clock),
-            until: clock() + us,
-        }
-    }
-
-    /// Whether the time is up.
-    pub fn spent(&self) -> bool {
-        self.clock.is_some_and(|c| c() > self.until)
-    }
-}
-
 /// What became of a request: in the session the answer's frame (`None`
 /// for a request the modem acknowledges and does not answer, [`Chip::
 /// expects_answer`]); views of one chip read it as that chip's command
@@ -259,105 +137,6 @@ pub enum Note {
     TReqUnanswered(u8),
 }
 
-/// The spread of a set of durations, µs.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Spread {
-    /// Median.
-    pub p50: Duration,
-    /// 99th percentile (nearest rank).
-    pub p99: Duration,
-    /// Longest.
-    pub max: Duration,
-}
-
-impl Spread {
-    /// The spread of `samples`, in order.
-    fn of(samples: &[Duration]) -> Spread {
-        // Nearest rank: the smallest value with at least p of the samples
-        // at or below it.
-        let rank = |p: usize| samples[(samples.len() * p).div_ceil(100).max(1) - 1];
-        match samples.last() {
-            None => Spread::default(),
-            Some(&max) => Spread {
-                p50: rank(50),
-                p99: rank(99),
-                max,
-            },
-        }
-    }
-}
-
-/// How quickly the host ACKs the modem's frames: from the arrival of a
-/// frame's last byte to the ACK written (UM0932 3.2.8: within T_ACK),
-/// over the last [`ACK_SAMPLES`] frames.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct AckLatency {
-    /// Frames ACKed since connecting.
-    pub count: u64,
-    /// On the transport's clock: what the modem saw. The session steps
-    /// the transport's time to each byte's arrival, and the simulated
-    /// modem's virtual time waits for the page, so this is 0 there.
-    pub link: Spread,
-    /// On the page's clock: how long after the byte arrived the page got
-    /// round to writing the ACK. It includes how late the page woke and
-    /// any stall, which a real modem would see as they are.
-    pub page: Spread,
-}
-
-/// The raw ACK latencies, bounded, and the same kept in order (a sample
-/// goes in and out by binary search: no sort, whose code would cost the
-/// page 1.5 KiB for this one list).
-#[derive(Debug, Default)]
-struct AckTimes {
-    count: u64,
-    /// (transport's clock, page's clock), oldest first.
-    samples: VecDeque<(Duration, Duration)>,
-    /// When each was written, on the page's clock (µs, the page's origin).
-    written: VecDeque<f64>,
-    /// The transport's clock's and the page's, each in order.
-    link: Vec<Duration>,
-    page: Vec<Duration>,
-}
-
-impl AckTimes {
-    fn record(&mut self, link: Duration, page: Duration, written: f64) {
-        if self.samples.len() == ACK_SAMPLES {
-            self.written.pop_front();
-            if let Some((l, p)) = self.samples.pop_front() {
-                take_out(&mut self.link, l);
-                take_out(&mut self.page, p);
-            }
-        }
-        self.samples.push_back((link, page));
-        self.written.push_back(written);
-        put_in(&mut self.link, link);
-        put_in(&mut self.page, page);
-        self.count += 1;
-    }
-
-    fn stats(&self) -> AckLatency {
-        AckLatency {
-            count: self.count,
-            link: Spread::of(&self.link),
-            page: Spread::of(&self.page),
-        }
-    }
-}
-
-/// Puts `x` into the ordered `v`.
-fn put_in(v: &mut Vec<Duration>, x: Duration) {
-    let i = v.partition_point(|&y| y <= x);
-    v.insert(i, x);
-}
-
-/// Takes one `x` out of the ordered `v`.
-fn take_out(v: &mut Vec<Duration>, x: Duration) {
-    let i = v.partition_point(|&y| y < x);
-    if v.get(i) == Some(&x) {
-        v.remove(i);
-    }
-}
-
 /// What a tick produced: notes for the stores and replies to call, both to
 /// be handled once the session is no longer borrowed.
 #[derive(Default)]
@@ -389,7 +168,8 @@ struct Active {
 
 /// The host side of one connection.
 pub struct Session {
-    transport: Option<Box<dyn Transport>>,
+    /// The transport, the page's clock on it, the ACK latency.
+    drive: Driver,
     host: HostEngine,
     /// The chip's host interface, with its decoding context.
     chip: Box<dyn Chip>,
@@ -397,18 +177,11 @@ pub struct Session {
     active: Option<Active>,
     /// A request code whose second answer is expected until the instant.
     duplicate_of: Option<(u8, Instant)>,
-    /// The page's clock mapped onto the transport's.
-    pacer: Pacer,
     /// Added to the transport's clock in every [`Note`]: the times of one
     /// connection carry on from where the last one stopped, so the log
     /// never runs backwards when the transport changes (the simulator's
     /// clock starts at 0, WebSerial's is the page's).
     log_offset: i64,
-    /// The page's clock at the current tick, on the transport's clock.
-    page_now: Instant,
-    /// The page's clock (µs) at the tick running now.
-    tick_at: f64,
-    ack_times: AckTimes,
     /// Requests in a row whose T_REQ went unanswered at least once.
     unanswered: u8,
     /// When notes were last handed out, µs of the page's clock.
@@ -429,17 +202,13 @@ impl Session {
     pub fn new(transport: Option<Box<dyn Transport>>, dialect: Dialect) -> Self {
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
         let mut s = Session {
-            transport,
+            drive: Driver::new(transport),
             host: HostEngine::new(dialect, HostConfig::at_reset(dialect, baud)),
             chip: chip::for_dialect(dialect),
             queue: VecDeque::new(),
             active: None,
             duplicate_of: None,
-            pacer: Pacer::default(),
             log_offset: 0,
-            page_now: 0,
-            tick_at: 0.0,
-            ack_times: AckTimes::default(),
             unanswered: 0,
             shown: 0.0,
             held: 0,
@@ -458,7 +227,7 @@ impl Session {
     /// the transport the modem's T_IC.
     fn configure(&mut self) {
         let t = self.timeouts;
-        let slack = self.transport.as_ref().map_or(0, |t| t.latency());
+        let slack = self.drive.transport.as_ref().map_or(0, |t| t.latency());
         let config = HostConfig {
             timeouts: Timeouts {
                 t_poll: t.t_poll + slack,
@@ -469,24 +238,24 @@ impl Session {
             ..self.host.config()
         };
         self.host.set_config(config);
-        if let Some(tr) = self.transport.as_mut() {
+        if let Some(tr) = self.drive.transport.as_mut() {
             tr.set_byte_gap_limit(t.t_ic);
         }
     }
 
     /// The transport, if connected to one.
     pub fn transport(&self) -> Option<&dyn Transport> {
-        self.transport.as_deref()
+        self.drive.transport.as_deref()
     }
 
     /// The transport, to change it (fault injection, baud).
     pub fn transport_mut(&mut self) -> Option<&mut (dyn Transport + 'static)> {
-        self.transport.as_deref_mut()
+        self.drive.transport.as_deref_mut()
     }
 
     /// Whether bytes can flow, and if not why.
     pub fn state(&self) -> LinkState {
-        match &self.transport {
+        match &self.drive.transport {
             Some(t) => t.state(),
             None => LinkState::Disconnected(
                 "not connected: connect to the simulated modem (connection bar)".to_string(),
@@ -505,7 +274,7 @@ impl Session {
     /// closed.
     pub fn replace_transport(&mut self, transport: Option<Box<dyn Transport>>, dialect: Dialect) {
         let why = match self.state() {
-            LinkState::Disconnected(why) if self.transport.is_some() => why,
+            LinkState::Disconnected(why) if self.drive.transport.is_some() => why,
             _ => "the connection was closed before the modem answered".to_string(),
         };
         self.fail_requests(&why);
@@ -514,19 +283,17 @@ impl Session {
         self.log_offset = ended as i64 - transport.as_ref().map_or(0, |t| t.now()) as i64;
         self.host = HostEngine::new(dialect, HostConfig::at_reset(dialect, baud));
         self.chip = chip::for_dialect(dialect);
-        self.transport = transport;
+        self.drive = Driver::new(transport);
         self.timeouts = Timeouts::at_reset(dialect, baud);
         self.configure();
-        self.pacer = Pacer::default();
         self.duplicate_of = None;
-        self.ack_times = AckTimes::default();
         self.out.notes.push(Note::TReq(false));
         self.out.notes.push(Note::Timeouts(self.timeouts));
     }
 
     /// Changes the UART baud rate of the transport and the engine.
     pub fn set_baud(&mut self, baud: u32) {
-        if let Some(t) = self.transport.as_mut() {
+        if let Some(t) = self.drive.transport.as_mut() {
             t.set_baud(baud);
         }
         let config = HostConfig {
@@ -543,7 +310,7 @@ impl Session {
 
     /// How quickly the host has ACKed the modem's frames since connecting.
     pub fn ack_latency(&self) -> AckLatency {
-        self.ack_times.stats()
+        self.drive.ack_latency()
     }
 
     /// The most recent ACK latencies one by one, oldest first: when the
@@ -551,9 +318,7 @@ impl Session {
     /// on the transport's clock and on the page's (for the bench, to find
     /// what held up the late ones).
     pub fn ack_samples(&self) -> Vec<(f64, Duration, Duration)> {
-        let times = self.ack_times.samples.iter();
-        let at = self.ack_times.written.iter();
-        at.zip(times).map(|(&w, &(l, p))| (w, l, p)).collect()
+        self.drive.ack_samples()
     }
 
     /// Requests not yet answered (the one outstanding and those queued).
@@ -571,12 +336,12 @@ impl Session {
         self.queue.push_back(Queued { frame, reply });
         let now = self.now();
         self.start_next(now);
-        self.drain(now);
+        driver::flush(self, now);
     }
 
     /// The transport's clock (0 when there is none).
     pub fn now(&self) -> Instant {
-        self.transport.as_ref().map_or(0, |t| t.now())
+        self.drive.now()
     }
 
     /// Lets the transport's time catch up with the page's clock `page_us`
@@ -590,17 +355,7 @@ impl Session {
                 self.fail_requests(&why);
             }
         }
-        if let Some((start, catch_up)) = self
-            .transport
-            .as_ref()
-            .map(|t| (t.now(), catch_up(t.as_ref())))
-        {
-            let busy = self.world_due();
-            let target = self.pacer.target_within(page_us, start, catch_up, busy);
-            self.page_now = self.pacer.page_now();
-            self.tick_at = page_us;
-            self.run_until(start, target, budget);
-        }
+        driver::tick(self, page_us, budget);
         self.take_due(page_us)
     }
 
@@ -642,7 +397,7 @@ impl Session {
     /// own accord still come when they come. It costs the line the page's
     /// layout once per hand-out.
     pub fn holds_line(&self) -> bool {
-        self.hold || (!self.out.notes.is_empty() && self.tick_at >= self.show_at())
+        self.hold || (!self.out.notes.is_empty() && self.drive.tick_at() >= self.show_at())
     }
 
     /// Whether notes were handed out since the last tick: the line is
@@ -680,7 +435,7 @@ impl Session {
     fn world_due(&self) -> Option<Instant> {
         earliest([
             self.host.poll_timeout(),
-            self.transport.as_ref().and_then(|t| t.next_event()),
+            self.drive.transport.as_ref().and_then(|t| t.next_event()),
             self.active.as_ref().and_then(|a| a.deadline),
             self.duplicate_of.map(|d| d.1),
         ])
@@ -690,50 +445,8 @@ impl Session {
     /// back are due.
     pub fn next_wake(&self) -> Option<f64> {
         let notes = (!self.out.notes.is_empty()).then_some(self.show_at());
-        let due = self.next_due().and_then(|t| self.pacer.page_at(t));
+        let due = self.next_due().and_then(|t| self.drive.pacer.page_at(t));
         [notes, due].into_iter().flatten().reduce(f64::min)
-    }
-
-    fn run_until(&mut self, start: Instant, target: Instant, budget: Budget) {
-        let mut t = start;
-        while t < target && !budget.spent() {
-            // Straight to the next thing due: a byte is taken, and ACKed,
-            // at the instant it arrives (UM0932 3.2.8, T_ACK).
-            let mut next = (t + SLICE).min(target);
-            if let Some(d) = self.next_due() {
-                if d > t && d < next {
-                    next = d;
-                }
-            }
-            // Nothing in flight and nothing due before the target: the
-            // time passes at once, and a waiting request leaves at the
-            // target, when the page asked for it.
-            let world = self.world_due();
-            if self.active.is_none() && !matches!(world, Some(d) if d < target) {
-                next = target;
-            }
-            let Some(transport) = self.transport.as_mut() else {
-                return;
-            };
-            let received = transport.poll(next);
-            for (at, byte) in received {
-                self.host.handle_rx(at, &[byte]);
-                self.drain(at);
-            }
-            if self.host.poll_timeout().is_some_and(|d| d <= next) {
-                self.host.handle_timeout(next);
-            }
-            self.expire(next);
-            self.start_next(next);
-            self.drain(next);
-            t = next;
-            // Answers go to their replies at the instant they came: a
-            // reply may send the next request, which then leaves at once
-            // rather than when the page next catches up.
-            if !self.out.replies.is_empty() {
-                break;
-            }
-        }
     }
 
     /// Hands the next queued request to the engine when none is
@@ -781,25 +494,6 @@ impl Session {
         }
     }
 
-    /// Writes what the engine wants written and handles its events.
-    fn drain(&mut self, now: Instant) {
-        while let Some(tx) = self.host.poll_transmit() {
-            let Some(t) = self.transport.as_mut() else {
-                break;
-            };
-            match tx {
-                Transmit::Bytes(b) => t.write(&b),
-                Transmit::TReq { asserted } => {
-                    t.set_treq(asserted);
-                    self.out.notes.push(Note::TReq(asserted));
-                }
-            }
-        }
-        while let Some(e) = self.host.poll_event() {
-            self.on_event(now, e);
-        }
-    }
-
     fn traffic(&mut self, at: Instant, element: &Element, from: Source) {
         let decoded = self.chip.decode(from, element);
         self.held += 1;
@@ -818,20 +512,7 @@ impl Session {
                 }
                 self.traffic(now, &el, Source::Modem);
             }
-            Event::Sent(el) => {
-                if matches!(el, Element::Ack) {
-                    // `now` is the arrival of the frame's last byte: the
-                    // engine ACKs in the `handle_rx` of that byte, and the
-                    // ACK has just been written.
-                    let written = self.now();
-                    self.ack_times.record(
-                        written.saturating_sub(now),
-                        self.page_now.max(written).saturating_sub(now),
-                        self.tick_at,
-                    );
-                }
-                self.traffic(now, &el, Source::Host)
-            }
+            Event::Sent(el) => self.traffic(now, &el, Source::Host),
             Event::Frame(f) => self.on_frame(now, f),
             Event::Repeat(_) => {}
             Event::Delivered(t) => {
@@ -957,7 +638,7 @@ impl Session {
                 .replies
                 .push((a.reply, Outcome::Failed(why.to_string())));
             self.host = HostEngine::new(self.chip.dialect(), self.host.config());
-            if let Some(t) = self.transport.as_mut() {
+            if let Some(t) = self.drive.transport.as_mut() {
                 t.set_treq(false);
             }
             self.out.notes.push(Note::TReq(false));
@@ -971,9 +652,60 @@ impl Session {
     }
 }
 
+/// The modem session on the console's one drive loop.
+impl Layer for Session {
+    type Engine = HostEngine;
+
+    fn acks(&self) -> bool {
+        true
+    }
+
+    fn parts(&mut self) -> (&mut HostEngine, &mut Driver) {
+        (&mut self.host, &mut self.drive)
+    }
+
+    fn is_ack(event: &Event) -> bool {
+        matches!(event, Event::Sent(Element::Ack))
+    }
+
+    fn on_event(&mut self, at: Instant, event: Event) {
+        self.on_event(at, event)
+    }
+
+    fn on_treq(&mut self, asserted: bool) {
+        self.out.notes.push(Note::TReq(asserted));
+    }
+
+    fn next_due(&self) -> Option<Instant> {
+        Session::next_due(self)
+    }
+
+    fn world_due(&self) -> Option<Instant> {
+        Session::world_due(self)
+    }
+
+    /// Nothing in flight and nothing due before the target: the time
+    /// passes at once, and a waiting request leaves at the target, when
+    /// the page asked for it.
+    fn idle_until(&self, target: Instant) -> bool {
+        self.active.is_none() && !matches!(self.world_due(), Some(d) if d < target)
+    }
+
+    fn at(&mut self, now: Instant) {
+        self.expire(now);
+        self.start_next(now);
+    }
+
+    /// Answers go to their replies at the instant they came.
+    fn stop(&self) -> bool {
+        !self.out.replies.is_empty()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::driver::{SIM_CATCH_UP, SLICE};
     use crate::transport::sim::SimTransport;
     use plm_sim::Fault;
     use std::cell::RefCell;
@@ -1322,29 +1054,6 @@ mod tests {
         assert_eq!(s.ack_latency(), AckLatency::default());
     }
 
-    #[test]
-    fn ack_latency_percentiles_cover_the_most_recent_samples() {
-        assert_eq!(Spread::of(&[]), Spread::default());
-        let one = Spread::of(&[7]);
-        assert_eq!((one.p50, one.p99, one.max), (7, 7, 7));
-        let mut backwards = AckTimes::default();
-        for i in (1..=100).rev() {
-            backwards.record(i, i, 0.0);
-        }
-        let hundred = backwards.stats().link;
-        assert_eq!((hundred.p50, hundred.p99, hundred.max), (50, 99, 100));
-        let mut t = AckTimes::default();
-        for i in 0..ACK_SAMPLES as u64 + 500 {
-            t.record(i, 2 * i, i as f64);
-        }
-        let l = t.stats();
-        assert_eq!(l.count, ACK_SAMPLES as u64 + 500);
-        assert_eq!(t.samples.len(), ACK_SAMPLES);
-        assert_eq!(l.link.max, ACK_SAMPLES as u64 + 499);
-        assert_eq!(l.link.p50, 500 + ACK_SAMPLES as u64 / 2 - 1);
-        assert_eq!(l.page.max, 2 * l.link.max);
-    }
-
     /// Issue 13: after the page stalled, the simulated modem carries on
     /// from where it was; its time does not replay the stall frame by
     /// frame, each ACK of the replay counting the page's lag again.
@@ -1366,8 +1075,8 @@ mod tests {
                 r(o);
             }
             let n = (s.ack_latency().count - before) as usize;
-            let new = s.ack_times.samples.iter().rev().take(n);
-            late.extend(new.map(|&(_, p)| p).filter(|&p| p > 2 * MS));
+            let new = s.ack_samples().into_iter().rev().take(n);
+            late.extend(new.map(|(_, _, p)| p).filter(|&p| p > 2 * MS));
             if seen.borrow().len() == 30 {
                 break;
             }

@@ -3,9 +3,10 @@
 //! session's [`Note`]s to them.
 
 use crate::clock::page_now_us;
+use crate::driver::{Budget, TICK_BUDGET_US};
 use crate::history_store;
 use crate::profile::Profile;
-use crate::session::{Budget, Note, Outcome, Session, Tick, TICK_BUDGET_US};
+use crate::session::{Note, Outcome, Session, Tick};
 use crate::storage::load;
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::street_store;
@@ -632,7 +633,7 @@ impl Console {
     }
 
     /// How quickly the host has ACKed the modem's frames since connecting.
-    pub fn ack_latency(&self) -> crate::session::AckLatency {
+    pub fn ack_latency(&self) -> crate::driver::ack::AckLatency {
         self.session().borrow().ack_latency()
     }
 

@@ -10,7 +10,7 @@ mod campaign;
 
 pub use campaign::Campaign;
 
-use crate::session::{Budget, Pacer};
+use crate::driver::{self, earliest, Budget, Driver, Layer};
 use crate::transport::{LinkState, Transport};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::energy::Meter;
@@ -22,7 +22,7 @@ use plm_core::app::{
     RequesterConfig,
 };
 use plm_core::decode::{Decoded, Decoder};
-use plm_core::link::host::{self, Transmit};
+use plm_core::link::host;
 use plm_core::link::{Dialect, Element, Source};
 use plm_core::time::{Duration, Instant, MS};
 use std::collections::{BTreeMap, VecDeque};
@@ -141,9 +141,9 @@ pub struct StreetTick {
 
 /// The street session.
 pub struct StreetSession {
-    transport: Option<Box<dyn Transport>>,
+    /// The transport, the page's clock on it, the ACK latency, the work.
+    drive: Driver,
     conc: Concentrator,
-    pacer: Pacer,
     discovery: Option<Discovery>,
     /// Boards the discovery had found when its current frame began (its
     /// belief of those left is updated at the end of each frame).
@@ -165,10 +165,6 @@ pub struct StreetSession {
     decoder: Decoder,
     out: StreetTick,
     campaign: Option<Campaign>,
-    /// Transport time run by [`StreetSession::tick`] since the session
-    /// began, and the page's time (µs) that took: the street's speed
-    /// ([`StreetSession::work`]).
-    work: (Duration, f64),
 }
 
 impl StreetSession {
@@ -176,9 +172,8 @@ impl StreetSession {
     /// modem concentrator, as the connection profile says).
     pub fn new(transport: Box<dyn Transport>, conc: Concentrator) -> Self {
         StreetSession {
-            transport: Some(transport),
+            drive: Driver::new(Some(transport)),
             conc,
-            pacer: Pacer::default(),
             discovery: None,
             found_before_frame: 0,
             session_no: 0,
@@ -192,7 +187,6 @@ impl StreetSession {
             decoder: Decoder::new(Dialect::St7580, Source::Any),
             out: StreetTick::default(),
             campaign: None,
-            work: (0, 0.0),
         }
     }
 
@@ -202,7 +196,7 @@ impl StreetSession {
             Box::new(crate::transport::sim::SimTransport::new(1, 57_600, 0)),
             Concentrator::usart(RequesterConfig::default()),
         );
-        s.transport = None;
+        s.drive.transport = None;
         s
     }
 
@@ -213,17 +207,18 @@ impl StreetSession {
 
     /// Runs a simulated street `speed` times as fast as the page's clock.
     pub fn set_speed(&mut self, speed: u32) {
-        self.pacer.speed = speed;
+        self.drive.pacer.speed = speed;
     }
 
     /// The transport.
     pub fn transport_mut(&mut self) -> Option<&mut (dyn Transport + 'static)> {
-        self.transport.as_deref_mut()
+        self.drive.transport.as_deref_mut()
     }
 
     /// Whether bytes flow.
     pub fn state(&self) -> LinkState {
-        self.transport
+        self.drive
+            .transport
             .as_ref()
             .map_or(LinkState::Disconnected("not connected".into()), |t| {
                 t.state()
@@ -232,14 +227,20 @@ impl StreetSession {
 
     /// The transport's clock.
     pub fn now(&self) -> Instant {
-        self.transport.as_ref().map_or(0, |t| t.now())
+        self.drive.now()
     }
 
     /// Transport time the page's ticks have run (µs), and the page's
     /// time that took (µs, the views' not counted): with a simulated
     /// street, its simulated seconds per wall second.
     pub fn work(&self) -> (Duration, f64) {
-        self.work
+        self.drive.work()
+    }
+
+    /// How quickly the console ACKs the bare modem's frames (none through
+    /// a board, which ACKs its modem itself).
+    pub fn ack_latency(&self) -> crate::driver::ack::AckLatency {
+        self.drive.ack_latency()
     }
 
     /// The lamps known so far.
@@ -280,7 +281,7 @@ impl StreetSession {
         self.found_before_frame = 0;
         self.out.found = true;
         self.conc.submit(now, first);
-        self.flush();
+        driver::flush(self, self.now());
     }
 
     /// Numbers the sessions of the discoveries to come from `last` on
@@ -401,7 +402,7 @@ impl StreetSession {
         }
         let id = self.conc.submit(now, request);
         self.purposes.push((id, purpose));
-        self.flush();
+        driver::flush(self, self.now());
     }
 
     /// Whether the round's lamps (or new boards) may be answering now.
@@ -432,76 +433,37 @@ impl StreetSession {
                 self.handle_happenings();
             }
         }
-        if let Some(start) = self.transport.as_ref().map(|t| t.now()) {
-            let target = self.pacer.target(page_us, start);
-            let began = crate::clock::page_now_us();
-            self.run_within(start, target, budget);
-            self.work.0 += self.now().saturating_sub(start);
-            self.work.1 += crate::clock::page_now_us() - began;
-        }
+        driver::tick(self, page_us, budget);
         self.take()
     }
 
     /// Runs the street as fast as possible up to `target` (tests).
+    /// The replies wait in [`StreetSession::take`].
     pub fn run_until(&mut self, start: Instant, target: Instant) {
-        self.run_within(start, target, Budget::UNLIMITED);
+        let mut t = start;
+        while t < target && self.drive.transport.is_some() {
+            driver::run_within(self, t, target, Budget::UNLIMITED);
+            t = self.now();
+        }
     }
 
     /// The next instant on the transport's clock at which something is
     /// due: the concentrator's, the discovery's, the sweep's and the
     /// update's deadlines, and the transport's next event.
     pub fn next_due(&self) -> Option<Instant> {
-        crate::session::earliest([
+        earliest([
             self.conc.poll_timeout(),
             self.discovery.as_ref().and_then(|d| d.poll_timeout()),
             self.round.as_ref().and_then(|r| r.poll_timeout()),
             self.next_sweep,
             self.update_timeout(),
-            self.transport.as_ref().and_then(|t| t.next_event()),
+            self.drive.transport.as_ref().and_then(|t| t.next_event()),
         ])
     }
 
     /// [`StreetSession::next_due`] on the page's clock (µs).
     pub fn next_wake(&self) -> Option<f64> {
-        self.next_due().and_then(|t| self.pacer.page_at(t))
-    }
-
-    fn run_within(&mut self, start: Instant, target: Instant, budget: Budget) {
-        let mut t = start;
-        while t < target && !budget.spent() {
-            let mut next = (t + crate::session::SLICE).min(target);
-            if let Some(d) = self.next_due().filter(|d| *d > t && *d < next) {
-                next = d;
-            }
-            let Some(transport) = self.transport.as_mut() else {
-                return;
-            };
-            for (at, byte) in transport.poll(next) {
-                self.conc.handle_rx(at, &[byte]);
-            }
-            if self.conc.poll_timeout().is_some_and(|d| d <= next) {
-                self.conc.handle_timeout(next);
-            }
-            self.handle_happenings();
-            self.run_discovery(next);
-            self.release_held(next);
-            self.run_sweep(next);
-            self.run_update(next);
-            self.flush();
-            t = next;
-        }
-    }
-
-    fn flush(&mut self) {
-        let Some(t) = self.transport.as_mut() else {
-            return;
-        };
-        while let Some(tx) = self.conc.poll_transmit() {
-            match tx {
-                Transmit::Bytes(b) => t.write(&b),
-                Transmit::TReq { asserted } => t.set_treq(asserted),
-            }
-        }
+        self.next_due().and_then(|t| self.drive.pacer.page_at(t))
     }
 
     fn run_discovery(&mut self, now: Instant) {
@@ -635,27 +597,31 @@ impl StreetSession {
     fn handle_happenings(&mut self) {
         let now = self.now();
         while let Some(h) = self.conc.poll_happening() {
-            match h {
-                Happening::App(e) => self.on_app(now, e),
-                Happening::Heard { address, snr } => {
-                    if let Some(l) = self.fleet.get_mut(&address).filter(|_| snr.is_some()) {
-                        l.snr = snr;
-                        l.snr_at = Some(now);
-                    }
+            self.on_happening(now, h);
+        }
+    }
+
+    fn on_happening(&mut self, now: Instant, h: Happening) {
+        match h {
+            Happening::App(e) => self.on_app(now, e),
+            Happening::Heard { address, snr } => {
+                if let Some(l) = self.fleet.get_mut(&address).filter(|_| snr.is_some()) {
+                    l.snr = snr;
+                    l.snr_at = Some(now);
                 }
-                Happening::Usart { to_board, element } => {
-                    let d = plm_core::decode::app::decode_element(&element);
-                    let from = if to_board { "host" } else { "board" };
-                    self.out.sent += to_board as u64;
-                    self.out.traffic.push((now, d.to_decoded(from)));
-                }
-                Happening::Link(host::Event::Sent(el)) => {
-                    self.out.sent += matches!(el, Element::Frame { .. }) as u64;
-                    self.link_traffic(now, &el, "host");
-                }
-                Happening::Link(host::Event::Received(el)) => self.link_traffic(now, &el, "modem"),
-                Happening::Link(_) => {}
             }
+            Happening::Usart { to_board, element } => {
+                let d = plm_core::decode::app::decode_element(&element);
+                let from = if to_board { "host" } else { "board" };
+                self.out.sent += to_board as u64;
+                self.out.traffic.push((now, d.to_decoded(from)));
+            }
+            Happening::Link(host::Event::Sent(el)) => {
+                self.out.sent += matches!(el, Element::Frame { .. }) as u64;
+                self.link_traffic(now, &el, "host");
+            }
+            Happening::Link(host::Event::Received(el)) => self.link_traffic(now, &el, "modem"),
+            Happening::Link(_) => {}
         }
     }
 
@@ -812,6 +778,50 @@ impl StreetSession {
             _ => {}
         }
         self.out.changed = true;
+    }
+}
+
+/// The street on the console's one drive loop.
+impl Layer for StreetSession {
+    type Engine = Concentrator;
+
+    /// Through a bare modem the console's host engine ACKs its frames;
+    /// through a board, the board does.
+    fn acks(&self) -> bool {
+        self.via_modem()
+    }
+
+    fn parts(&mut self) -> (&mut Concentrator, &mut Driver) {
+        (&mut self.conc, &mut self.drive)
+    }
+
+    fn is_ack(h: &Happening) -> bool {
+        matches!(h, Happening::Link(host::Event::Sent(Element::Ack)))
+    }
+
+    fn on_event(&mut self, at: Instant, h: Happening) {
+        self.on_happening(at, h)
+    }
+
+    fn next_due(&self) -> Option<Instant> {
+        StreetSession::next_due(self)
+    }
+
+    fn world_due(&self) -> Option<Instant> {
+        StreetSession::next_due(self)
+    }
+
+    fn at(&mut self, now: Instant) {
+        self.run_discovery(now);
+        self.release_held(now);
+        self.run_sweep(now);
+        self.run_update(now);
+    }
+
+    /// Replies go to the views at the instant they came: a reply may send
+    /// the next request.
+    fn stop(&self) -> bool {
+        !self.out.replies.is_empty()
     }
 }
 
@@ -1021,7 +1031,7 @@ mod tests {
         }
 
         // The page reloads; the boards keep what they were told.
-        let mut t = s.transport.take().unwrap();
+        let mut t = s.drive.transport.take().unwrap();
         t.simulator().unwrap().lamp(late, LampAction::Join);
         let mut s = StreetSession::new(t, usart());
         s.recall(session, known.clone());

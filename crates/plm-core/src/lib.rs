@@ -47,6 +47,7 @@ pub(crate) type CrcImpl = crc::NoTable;
 pub mod app;
 pub mod chip;
 pub mod decode;
+pub mod drive;
 pub mod field;
 mod field_json;
 pub mod file;

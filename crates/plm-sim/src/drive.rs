@@ -3,10 +3,38 @@
 //! Tests and `cargo xtask bench` use it.
 
 use crate::sim::Sim;
-use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
+use plm_core::drive::{turn, Io};
+use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket};
 use plm_core::link::Dialect;
 use plm_core::st7580::{code, Command};
-use plm_core::time::{earliest, Duration, Instant};
+use plm_core::time::{Duration, Instant};
+use std::convert::Infallible;
+
+/// Node 0's host UART as plm-core's drive loop sees it: time passes as
+/// fast as the loop asks, to the next thing that happens in the world.
+impl Io for Sim {
+    type Error = Infallible;
+    fn now(&self) -> Instant {
+        Sim::now(self)
+    }
+    fn wait(&mut self, until: Instant, rx: &mut Vec<(Instant, u8)>) -> Result<(), Infallible> {
+        let next = self
+            .next_deadline()
+            .unwrap_or(until)
+            .clamp(Sim::now(self), until);
+        self.advance_to(next);
+        rx.extend(self.host_read());
+        Ok(())
+    }
+    fn write(&mut self, bytes: &[u8]) -> Result<(), Infallible> {
+        Sim::write(self, bytes);
+        Ok(())
+    }
+    fn set_treq(&mut self, asserted: bool) -> Result<(), Infallible> {
+        Sim::set_treq(self, asserted);
+        Ok(())
+    }
+}
 
 /// A host engine joined to a simulation.
 #[derive(Debug, Clone)]
@@ -61,31 +89,21 @@ impl HostDriver {
         let end = self.sim.now() + limit;
         let mut seen = self.events.len();
         loop {
-            self.push_transmits();
             while seen < self.events.len() {
                 seen += 1;
                 if done(&self.events[seen - 1].1) {
                     return true;
                 }
             }
-            let next = earliest(self.host.poll_timeout(), self.sim.next_deadline());
-            match next {
-                Some(t) if t <= end => self.sim.advance_to(t),
-                _ => {
-                    self.sim.advance_to(end);
-                    return false;
-                }
+            if self.sim.now() >= end {
+                return false;
             }
-            let now = self.sim.now();
-            for (at, b) in self.sim.host_read() {
-                self.host.handle_rx(at, &[b]);
-            }
-            if self.host.poll_timeout().is_some_and(|t| t <= now) {
-                self.host.handle_timeout(now);
-            }
-            while let Some(e) = self.host.poll_event() {
-                self.events.push((now, e));
-            }
+            let events = &mut self.events;
+            let Ok(now) = turn(&mut self.host, &mut self.sim, end, |host, at| {
+                events.extend(std::iter::from_fn(|| host.poll_event()).map(|e| (at, e)))
+            });
+            self.events
+                .extend(std::iter::from_fn(|| self.host.poll_event()).map(|e| (now, e)));
         }
     }
 
@@ -122,14 +140,5 @@ impl HostDriver {
                 _ => None,
             })
             .collect()
-    }
-
-    fn push_transmits(&mut self) {
-        while let Some(t) = self.host.poll_transmit() {
-            match t {
-                Transmit::Bytes(b) => self.sim.write(&b),
-                Transmit::TReq { asserted } => self.sim.set_treq(asserted),
-            }
-        }
     }
 }

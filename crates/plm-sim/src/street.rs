@@ -4,15 +4,19 @@
 //! way in ([`Attach`]). Tests and `cargo xtask bench` use it.
 
 use crate::sim::{Attach, Sim};
+use plm_core::app::job::{self, Begun, Job, Run};
 use plm_core::app::read_all::ReadAll;
 use plm_core::app::{
-    Address, AppEvent, Concentrator, Discovery, Happening, Listener, Message, Request, RequestId,
+    Address, AppEvent, Concentrator, Discovery, Happening, Message, Request, RequestId,
     RequesterConfig,
 };
-use plm_core::link::host::Transmit;
+use plm_core::drive;
 use plm_core::st7580::TxParams;
-use plm_core::time::{earliest, Duration, Instant, MS};
+use plm_core::time::{Duration, Instant};
 use std::collections::BTreeMap;
+
+/// A limit no job of a test reaches (a job always has a deadline).
+const FOREVER: Duration = Duration::MAX / 4;
 
 /// A concentrator driving a simulated street.
 #[derive(Debug, Clone)]
@@ -89,34 +93,16 @@ impl StreetDriver {
     }
 
     fn flush(&mut self) {
-        while let Some(t) = self.conc.poll_transmit() {
-            match t {
-                Transmit::Bytes(b) => self.sim.write(&b),
-                Transmit::TReq { asserted } => self.sim.set_treq(asserted),
-            }
-        }
+        let Ok(()) = drive::flush(&mut self.conc, &mut self.sim);
     }
 
-    /// Runs one step: to the next deadline of the world or the
-    /// concentrator, at most `until`. Returns the happenings of the step.
+    /// Runs one turn of plm-core's drive loop: to the next deadline of the
+    /// world or the concentrator, at most `until`. Returns the happenings
+    /// of the turn.
     pub fn step(&mut self, until: Instant) -> Vec<Happening> {
-        let next = earliest(self.sim.next_deadline(), self.conc.poll_timeout())
-            .unwrap_or(until)
-            .clamp(self.sim.now(), until);
-        self.sim.advance_to(next);
-        let now = self.sim.now();
-        for (at, byte) in self.sim.host_read() {
-            self.conc.handle_rx(at, &[byte]);
-        }
-        if self.conc.poll_timeout().is_some_and(|t| t <= now) {
-            self.conc.handle_timeout(now);
-        }
-        self.flush();
-        let mut out = Vec::new();
-        while let Some(h) = self.conc.poll_happening() {
-            self.log.push((now, h.clone()));
-            out.push(h);
-        }
+        let Ok(now) = drive::turn(&mut self.conc, &mut self.sim, until, |_, _| {});
+        let out: Vec<Happening> = std::iter::from_fn(|| self.conc.poll_happening()).collect();
+        self.log.extend(out.iter().map(|h| (now, h.clone())));
         out
     }
 
@@ -139,14 +125,9 @@ impl StreetDriver {
 
     /// Sends a request and waits for its fate (answer, failure, or sent).
     pub fn request(&mut self, request: Request, limit: Duration) -> Option<AppEvent> {
-        let id = self.submit(request);
-        let mut fate = None;
-        self.run_until(limit, |h| match h {
-            Happening::App(e) if e.fate_of() == Some(id) => {
-                fate = Some(e.clone());
-                true
-            }
-            _ => false,
+        let log = &mut self.log;
+        let Ok(fate) = job::fate(&mut self.conc, &mut self.sim, request, limit, |at, h| {
+            log.push((at, h.clone()))
         });
         fate
     }
@@ -165,29 +146,29 @@ impl StreetDriver {
         }
     }
 
-    /// Runs a firmware update campaign to its end: every request the
-    /// engine hands out goes through the concentrator, its answer (or
-    /// failure) back to the engine.
+    /// Runs `job` to its end on the concentrator (plm-core's loop,
+    /// [`job::drive`]), for at most `limit`; returns the job and whether
+    /// it ended.
+    pub fn run_job<J: Job>(&mut self, job: J, limit: Duration) -> (J, bool) {
+        let mut run = Run::new(job);
+        let until = self.sim.now() + limit;
+        let log = &mut self.log;
+        let Ok(done) = job::drive(
+            &mut run,
+            &mut self.conc,
+            &mut self.sim,
+            until,
+            |_, at, hs| {
+                log.extend(hs.iter().map(|h| (at, h.clone())));
+                Ok(())
+            },
+        );
+        (run.into_job(), done)
+    }
+
+    /// Runs a firmware update campaign to its end.
     pub fn update(&mut self, u: &mut plm_core::app::update::Update) {
-        while !u.is_done() {
-            let now = self.sim.now();
-            match u.poll(now) {
-                Some(request) => match self.request(request, 120 * 1_000 * MS) {
-                    Some(AppEvent::Answered { answer, .. }) => {
-                        u.on_answer(self.sim.now(), Ok(answer))
-                    }
-                    Some(AppEvent::Failed { reason, .. }) => {
-                        u.on_answer(self.sim.now(), Err(reason))
-                    }
-                    Some(_) => {}
-                    None => u.on_answer(self.sim.now(), Err("no answer within 2 minutes".into())),
-                },
-                None => {
-                    let until = u.poll_timeout().unwrap_or(now + 100 * MS);
-                    self.run_for(until.saturating_sub(now).max(1));
-                }
-            }
-        }
+        self.run_job(u, FOREVER);
     }
 
     /// Reads `boards` in slots (plm-core's [`ReadAll`]): every request
@@ -199,33 +180,8 @@ impl StreetDriver {
         boards: &[Address],
         config: plm_core::app::read_all::ReadConfig,
     ) -> ReadAll {
-        let (mut r, first) = ReadAll::start(self.sim.now(), boards, config);
-        if let Some(first) = first {
-            self.submit(first);
-        }
-        self.listen(&mut r);
-        r
-    }
-
-    /// Runs `engine` to its end: what boards send unasked handed to it,
-    /// what it hands out sent.
-    fn listen(&mut self, engine: &mut impl Listener) {
-        while !engine.done() {
-            let until = engine.due().unwrap_or(self.sim.now());
-            for h in self.step(until) {
-                if let Happening::App(AppEvent::Unsolicited {
-                    address, message, ..
-                }) = h
-                {
-                    if let Some(answer) = engine.hear(address, &message) {
-                        self.send(answer);
-                    }
-                }
-            }
-            if let Some(next) = engine.tick(self.sim.now()) {
-                self.submit(next);
-            }
-        }
+        let (r, first) = ReadAll::start(self.sim.now(), boards, config);
+        self.run_job(Begun::new(r, first), FOREVER).0.job
     }
 
     /// Discovers the boards on the line (plm-core's rule); returns what
@@ -234,9 +190,8 @@ impl StreetDriver {
         &mut self,
         config: plm_core::app::discovery::DiscoveryConfig,
     ) -> BTreeMap<Address, plm_core::app::Discovered> {
-        let (mut d, first) = Discovery::start(self.sim.now(), config);
-        self.submit(first);
-        self.listen(&mut d);
+        let (d, first) = Discovery::start(self.sim.now(), config);
+        let d = self.run_job(Begun::new(d, Some(first)), FOREVER).0.job;
         d.found().iter().copied().collect()
     }
 }

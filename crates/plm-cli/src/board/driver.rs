@@ -9,12 +9,13 @@
 use super::Failure;
 use crate::port::Port;
 use plm_core::app::discovery::{DiscoveryConfig, Rounds};
+use plm_core::app::job::{self, Begun, Job, Run};
 use plm_core::app::sweep::Round;
 use plm_core::app::{
-    Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Listener, Message,
-    Request, RequestId,
+    Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Message, Request,
+    RequestId,
 };
-use plm_core::link::host::Transmit;
+use plm_core::drive::{self, Io};
 use plm_core::time::Instant;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -36,73 +37,85 @@ pub fn interrupted() -> bool {
 /// by default); this only guards against a request that never ends.
 const REQUEST_GUARD: Duration = Duration::from_secs(60);
 
-/// A concentrator on a port.
-pub struct Driver {
+/// No job of `plm board` ends by this limit: each ends by itself, or by
+/// Ctrl-C.
+const FOREVER: Instant = Instant::MAX / 4;
+
+/// A real port on the wall clock, as plm-core's drive loop sees it.
+struct Wall {
     port: Box<dyn Port>,
-    conc: Concentrator,
     /// The port as the user named it, for messages.
     url: String,
     start: std::time::Instant,
+}
+
+impl Wall {
+    fn lost(&self, e: std::io::Error) -> Failure {
+        Failure::port(format!("lost the port {}: {e}", self.url))
+    }
+}
+
+impl Io for Wall {
+    type Error = Failure;
+
+    /// Microseconds since the driver started.
+    fn now(&self) -> Instant {
+        self.start.elapsed().as_micros() as Instant
+    }
+
+    /// Waits for bytes at most until `until` and [`TICK`]; each byte is
+    /// stamped with the time it was read. Fails when Ctrl-C was pressed.
+    fn wait(&mut self, until: Instant, rx: &mut Vec<(Instant, u8)>) -> Result<(), Failure> {
+        if interrupted() {
+            return Err(Failure::interrupted());
+        }
+        let wait = Duration::from_micros(until.saturating_sub(self.now())).min(TICK);
+        let bytes = self.port.read(wait).map_err(|e| self.lost(e))?;
+        let now = self.now();
+        rx.extend(bytes.into_iter().map(|b| (now, b)));
+        Ok(())
+    }
+
+    fn write(&mut self, bytes: &[u8]) -> Result<(), Failure> {
+        self.port.write(bytes).map_err(|e| self.lost(e))
+    }
+
+    fn set_treq(&mut self, asserted: bool) -> Result<(), Failure> {
+        self.port.set_rts(asserted).map_err(|e| self.lost(e))
+    }
+}
+
+/// A concentrator on a port.
+pub struct Driver {
+    wall: Wall,
+    conc: Concentrator,
 }
 
 impl Driver {
     /// Drives `conc` over `port` (opened from `url`), time 0 now.
     pub fn new(port: Box<dyn Port>, conc: Concentrator, url: &str) -> Driver {
         Driver {
-            port,
+            wall: Wall {
+                port,
+                url: url.to_string(),
+                start: std::time::Instant::now(),
+            },
             conc,
-            url: url.to_string(),
-            start: std::time::Instant::now(),
         }
     }
 
     /// Concentrator time: microseconds since the driver started.
     pub fn now(&self) -> Instant {
-        self.start.elapsed().as_micros() as Instant
+        self.wall.now()
     }
 
-    fn lost(&self, e: std::io::Error) -> Failure {
-        Failure::port(format!("lost the port {}: {e}", self.url))
-    }
-
-    /// Writes what the concentrator has for the port.
-    fn flush(&mut self) -> Result<(), Failure> {
-        while let Some(t) = self.conc.poll_transmit() {
-            let r = match t {
-                Transmit::Bytes(b) => self.port.write(&b),
-                Transmit::TReq { asserted } => self.port.set_rts(asserted),
-            };
-            r.map_err(|e| self.lost(e))?;
-        }
-        Ok(())
-    }
-
-    /// One turn, waiting for bytes at most until `until` (and [`TICK`]).
-    /// Fails when the port is lost or Ctrl-C was pressed.
+    /// One turn of plm-core's drive loop, waiting for bytes at most until
+    /// `until` (and [`TICK`]). Fails when the port is lost or Ctrl-C was
+    /// pressed.
     pub fn step(&mut self, until: Option<Instant>) -> Result<Vec<Happening>, Failure> {
-        if interrupted() {
-            return Err(Failure::interrupted());
-        }
-        let now = self.now();
-        let due = [self.conc.poll_timeout(), until]
-            .into_iter()
-            .flatten()
-            .min()
-            .map_or(TICK, |t| Duration::from_micros(t.saturating_sub(now)));
-        let bytes = self.port.read(due.min(TICK)).map_err(|e| self.lost(e))?;
-        let now = self.now();
-        if !bytes.is_empty() {
-            self.conc.handle_rx(now, &bytes);
-        }
-        if self.conc.poll_timeout().is_some_and(|t| t <= now) {
-            self.conc.handle_timeout(now);
-        }
-        self.flush()?;
-        let mut out = Vec::new();
-        while let Some(h) = self.conc.poll_happening() {
-            out.push(h);
-        }
-        Ok(out)
+        let until = until.unwrap_or(FOREVER);
+        drive::turn(&mut self.conc, &mut self.wall, until, |_, _| {})?;
+        Ok(std::iter::from_fn(|| self.conc.poll_happening()).collect())
     }
 
     /// Runs turns until `until`.
@@ -116,39 +129,30 @@ impl Driver {
     /// Queues a request.
     pub fn submit(&mut self, request: Request) -> Result<RequestId, Failure> {
         let id = self.conc.submit(self.now(), request);
-        self.flush()?;
+        drive::flush(&mut self.conc, &mut self.wall)?;
         Ok(id)
     }
 
     /// Sends a frame that answers nothing (a discovery ACK).
     pub fn send(&mut self, frame: AppFrame) -> Result<(), Failure> {
         self.conc.send(self.now(), frame);
-        self.flush()
+        drive::flush(&mut self.conc, &mut self.wall)
     }
 
     /// Sends a request and waits for its fate: answered, failed, or (for
     /// a request that expects no answer) sent.
     pub fn request(&mut self, request: Request) -> Result<AppEvent, Failure> {
         let address = request.address;
-        let id = self.submit(request)?;
-        let give_up = self.now() + REQUEST_GUARD.as_micros() as Instant;
-        while self.now() < give_up {
-            for h in self.step(None)? {
-                if let Happening::App(e) = h {
-                    if e.fate_of() == Some(id) {
-                        return Ok(e);
-                    }
-                }
-            }
-        }
-        Ok(AppEvent::Failed {
-            id,
+        let guard = REQUEST_GUARD.as_micros() as Instant;
+        let fate = job::fate(&mut self.conc, &mut self.wall, request, guard, |_, _| {})?;
+        Ok(fate.unwrap_or_else(|| AppEvent::Failed {
+            id: RequestId(u32::MAX),
             address,
             reason: format!(
                 "no answer within {} s (the requester never gave up: a bug)",
                 REQUEST_GUARD.as_secs()
             ),
-        })
+        }))
     }
 
     /// The answer of one board, or why there is none, in words.
@@ -164,6 +168,16 @@ impl Driver {
         })
     }
 
+    /// Runs `run` to its end (plm-core's loop, [`job::drive`]); `each` is
+    /// called after every turn with the happenings it brought.
+    pub fn run<J: Job>(
+        &mut self,
+        run: &mut Run<J>,
+        each: impl FnMut(&mut Run<J>, Instant, &[Happening]) -> Result<(), Failure>,
+    ) -> Result<(), Failure> {
+        job::drive(run, &mut self.conc, &mut self.wall, FOREVER, each).map(|_| ())
+    }
+
     /// Discovery (plm-core's rule), then with `older_rule` a round of the
     /// older rule: each board is handed to `found` the first time it is
     /// heard.
@@ -173,22 +187,25 @@ impl Driver {
         older_rule: bool,
         mut found: impl FnMut(Address, Discovered),
     ) -> Result<Discovery, Failure> {
-        let (mut d, first) = Discovery::start(self.now(), config);
-        self.submit(first)?;
+        let (d, first) = Discovery::start(self.now(), config);
+        let mut run = Run::new(Begun::new(d, Some(first)));
         let mut told = 0;
-        self.listen(&mut d, |d| {
-            for (a, info) in &d.found()[told..] {
+        self.run(&mut run, |run, _, _| {
+            let heard = run.job().job.found();
+            for (a, info) in &heard[told..] {
                 found(*a, *info);
             }
-            told = d.found().len();
+            told = heard.len();
+            Ok(())
         })?;
+        let mut d = run.into_job().job;
         if older_rule {
             // A round of rule 1 for boards still on it (protocol notes,
             // "Discovery").
-            let (mut r, first) = Rounds::start(self.now(), config.session, 1, 3);
-            self.submit(first)?;
-            self.listen(&mut r, |_| {})?;
-            for (a, info) in r.found() {
+            let (r, first) = Rounds::start(self.now(), config.session, 1, 3);
+            let mut run = Run::new(Begun::new(r, Some(first)));
+            self.run(&mut run, |_, _, _| Ok(()))?;
+            for (a, info) in run.job().job.found() {
                 if d.record_found(*a, *info) {
                     found(*a, *info);
                 }
@@ -201,64 +218,6 @@ impl Driver {
     /// request it gives sent, the fate of each unicast one and what boards
     /// send unasked handed back; what was read stays in it.
     pub fn run_round(&mut self, round: &mut Round) -> Result<(), Failure> {
-        let mut asked = None;
-        while !round.is_done() {
-            if asked.is_none() {
-                if let Some(q) = round.poll(self.now()) {
-                    let unicast = !q.broadcast;
-                    let id = self.submit(q)?;
-                    asked = unicast.then_some(id);
-                    continue;
-                }
-            }
-            for h in self.step(round.poll_timeout())? {
-                let Happening::App(e) = h else { continue };
-                match e {
-                    AppEvent::Unsolicited {
-                        address, message, ..
-                    } => {
-                        if let Some(answer) = round.hear(address, &message) {
-                            self.send(answer)?;
-                        }
-                    }
-                    AppEvent::Answered { id, answer, .. } if Some(id) == asked => {
-                        asked = None;
-                        round.on_answer(Ok(answer));
-                    }
-                    AppEvent::Failed { id, reason, .. } if Some(id) == asked => {
-                        asked = None;
-                        round.on_answer(Err(reason));
-                    }
-                    _ => {}
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// Runs `engine` to its end: what boards send unasked handed to it
-    /// (and `heard` called after each), what it hands out sent.
-    fn listen<L: Listener>(
-        &mut self,
-        engine: &mut L,
-        mut heard: impl FnMut(&L),
-    ) -> Result<(), Failure> {
-        while !engine.done() {
-            for h in self.step(engine.due())? {
-                if let Happening::App(AppEvent::Unsolicited {
-                    address, message, ..
-                }) = h
-                {
-                    if let Some(answer) = engine.hear(address, &message) {
-                        self.send(answer)?;
-                    }
-                    heard(engine);
-                }
-            }
-            if let Some(next) = engine.tick(self.now()) {
-                self.submit(next)?;
-            }
-        }
-        Ok(())
+        self.run(&mut Run::new(round), |_, _, _| Ok(()))
     }
 }

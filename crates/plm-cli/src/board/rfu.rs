@@ -3,13 +3,13 @@
 //! answer so that it survives Ctrl-C, a lost port or a crash; and the
 //! simulated images to try it on `plm sim`.
 
-use super::driver::{interrupted, Driver};
+use super::driver::Driver;
 use super::{connect, exit, session, BoardArgs, Failure, ImageArgs, RfuArgs};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::rfu::{self, image};
 use plm_core::app::update::{BoardState, Update, UpdateConfig};
-use plm_core::app::{Address, AppEvent, Happening, RequestId};
+use plm_core::app::{Address, Happening, Run};
 use plm_core::time::MS;
 use serde_json::json;
 use std::io::{IsTerminal, Write};
@@ -282,38 +282,17 @@ fn drive(
     state: &State,
     progress: &mut Progress,
 ) -> Result<(), Failure> {
-    let mut in_flight: Option<RequestId> = None;
-    while !(u.is_done() && in_flight.is_none()) {
-        if in_flight.is_none() {
-            if let Some(request) = u.poll(d.now()) {
-                in_flight = Some(d.submit(request)?);
-            }
+    d.run(&mut Run::new(u), |run, now, happenings| {
+        // Every request is the campaign's: saved after each fate.
+        let fate = happenings
+            .iter()
+            .any(|h| matches!(h, Happening::App(e) if e.fate_of().is_some()));
+        if fate {
+            state.save(run.job())?;
         }
-        let until = if in_flight.is_none() {
-            u.poll_timeout()
-        } else {
-            None
-        };
-        for h in d.step(until)? {
-            let Happening::App(e) = h else { continue };
-            if in_flight.is_none() || e.fate_of() != in_flight {
-                continue;
-            }
-            in_flight = None;
-            match e {
-                AppEvent::Answered { answer, .. } => u.on_answer(d.now(), Ok(answer)),
-                AppEvent::Failed { reason, .. } => u.on_answer(d.now(), Err(reason)),
-                // A segment: sent, no answer expected.
-                _ => {}
-            }
-            state.save(u)?;
-        }
-        progress.show(u, d.now());
-        if interrupted() {
-            return Err(Failure::interrupted());
-        }
-    }
-    Ok(())
+        progress.show(run.job(), now);
+        Ok(())
+    })
 }
 
 /// Progress on stderr: one line refreshed in place on a terminal, a

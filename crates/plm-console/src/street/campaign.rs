@@ -312,7 +312,7 @@ mod tests {
         run(&mut s, 6 * S);
         let saved = s.campaign().unwrap().update.save();
         // The page goes; the street (behind the cable) stays.
-        let transport = s.transport.take().unwrap();
+        let transport = s.drive.transport.take().unwrap();
         let mut s = StreetSession::new(transport, Concentrator::usart(RequesterConfig::default()));
         assert!(
             s.resume_update(vec![0; 10], &saved).is_err(),

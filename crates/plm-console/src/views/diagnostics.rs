@@ -6,7 +6,8 @@ use super::widgets::{
     action_button, button, checkbox, escape, html, note, on_click, signal, text, text_input,
 };
 use super::{millis, seconds, spaced};
-use crate::session::{Outcome, ACK_SAMPLES};
+use crate::driver::ack::ACK_SAMPLES;
+use crate::session::Outcome;
 use crate::stores::{refusal, unstamped, use_console};
 use leptos::prelude::*;
 use plm_core::field::Field;

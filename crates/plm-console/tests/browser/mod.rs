@@ -4,7 +4,8 @@
 
 use js_sys::Promise;
 use plm_console::clock::page_now_us;
-use plm_console::session::{Budget, Note, Outcome, Session};
+use plm_console::driver::Budget;
+use plm_console::session::{Note, Outcome, Session};
 use plm_core::st7580::Command;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;

@@ -71,6 +71,8 @@ pub enum Happening {
     },
 }
 
+crate::drive::engine!(Concentrator, Happening, poll_happening);
+
 /// The concentrator.
 #[derive(Debug, Clone)]
 pub struct Concentrator {

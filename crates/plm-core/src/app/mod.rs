@@ -12,7 +12,8 @@
 //! - [`usart`]: the USART stream decoder; [`requester`]: requests and
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
 //!   USART or a bare ST7580; [`discovery`]: finding the boards on a line;
-//!   [`read_all`]: reading many boards in slots.
+//!   [`read_all`]: reading many boards in slots; [`job`]: any of these
+//!   run on a concentrator by one loop.
 //! - [`energy`]: a lamp's energy estimated from its power readings.
 //! - [`rfu`]: remote firmware update, the layouts of its commands;
 //!   [`update`]: the engine that updates one board or a street.
@@ -27,8 +28,8 @@ pub mod energy;
 pub mod error;
 pub mod frame;
 pub mod hid;
+pub mod job;
 pub mod line;
-pub mod listener;
 pub mod message;
 pub mod read_all;
 mod release;
@@ -44,8 +45,8 @@ pub use discovery::Discovery;
 pub use error::ErrorCode;
 pub use frame::{Address, AppFrame, FrameError, FrameType};
 pub use hid::{Ballast, Hid, LampState};
+pub use job::{Job, Run};
 pub use line::LineFrame;
-pub use listener::Listener;
 pub use message::{Expect, Message, MessageError};
 pub use release::Release;
 pub use requester::{AppEvent, Request, RequestId, Requester, RequesterConfig};

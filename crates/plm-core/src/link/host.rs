@@ -24,17 +24,9 @@ use crate::time::{earliest, wire_time, Duration, Instant, TxClock, MS};
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 
-/// Something the driver must do on the wire.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Transmit {
-    /// Write these bytes.
-    Bytes(Vec<u8>),
-    /// Set T_REQ: `asserted` means pulled low (a request to send).
-    TReq {
-        /// Whether T_REQ is asserted (low).
-        asserted: bool,
-    },
-}
+pub use crate::drive::Transmit;
+
+crate::drive::engine!(HostEngine, Event, poll_event);
 
 /// Identifies a submitted frame in later events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

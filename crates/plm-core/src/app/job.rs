@@ -1,0 +1,342 @@
+//! A job on the street, run on a concentrator: what discovery, a round of
+//! reads, a read in slots, a firmware update and a single request have in
+//! common, so that every driver (`plm board`, plm-sim's street, the
+//! console) runs them with one loop ([`drive`]) over one router ([`Run`]).
+//! Sans-IO: [`Run`] submits the job's requests one at a time, each after
+//! the fate of the one before, hands the job each fate and what boards send
+//! unasked, and sends what it answers them.
+
+use super::concentrator::{Concentrator, Happening};
+use super::discovery::{Discovery, Rounds};
+use super::frame::{Address, AppFrame};
+use super::message::Message;
+use super::read_all::ReadAll;
+use super::requester::{AppEvent, Request, RequestId};
+use super::sweep::Round;
+use super::update::Update;
+use crate::drive::{self, Io};
+use crate::time::Instant;
+use alloc::string::String;
+
+/// A sans-IO job that hands out requests and takes what comes back.
+pub trait Job {
+    /// The next request to send now, if any (called only when the last
+    /// one's fate is known).
+    fn poll(&mut self, now: Instant) -> Option<Request>;
+    /// The fate of the last request that expected an answer: the answer,
+    /// or why there is none.
+    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>);
+    /// A frame that came unasked; the frame to send back, if any.
+    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame>;
+    /// When [`Job::poll`] is due for time.
+    fn poll_timeout(&self) -> Option<Instant>;
+    /// Whether it is over.
+    fn is_done(&self) -> bool;
+}
+
+/// A job lent to a run: the caller keeps it.
+impl<J: Job + ?Sized> Job for &mut J {
+    fn poll(&mut self, now: Instant) -> Option<Request> {
+        (**self).poll(now)
+    }
+    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
+        (**self).on_answer(now, answer)
+    }
+    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+        (**self).hear(address, message)
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        (**self).poll_timeout()
+    }
+    fn is_done(&self) -> bool {
+        (**self).is_done()
+    }
+}
+
+/// A job and the request it began with, not yet sent (discovery and a
+/// read in slots begin with a request).
+#[derive(Debug, Clone)]
+pub struct Begun<J> {
+    first: Option<Request>,
+    /// The job.
+    pub job: J,
+}
+
+impl<J> Begun<J> {
+    /// `job`, whose first request is `first`.
+    pub fn new(job: J, first: Option<Request>) -> Self {
+        Begun { first, job }
+    }
+}
+
+impl<J: Job> Job for Begun<J> {
+    fn poll(&mut self, now: Instant) -> Option<Request> {
+        self.first.take().or_else(|| self.job.poll(now))
+    }
+    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
+        self.job.on_answer(now, answer)
+    }
+    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+        self.job.hear(address, message)
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        self.job.poll_timeout()
+    }
+    fn is_done(&self) -> bool {
+        self.first.is_none() && self.job.is_done()
+    }
+}
+
+/// [`Job`] over the broadcasting engines' own methods (`handle_timeout`
+/// gives the next broadcast, `on_message` hears a board).
+macro_rules! broadcasts {
+    ($engine:ty, $hear:expr) => {
+        impl Job for $engine {
+            fn poll(&mut self, now: Instant) -> Option<Request> {
+                self.handle_timeout(now)
+            }
+            fn on_answer(&mut self, _: Instant, _: Result<Message, String>) {}
+            fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+                $hear(self, address, message)
+            }
+            fn poll_timeout(&self) -> Option<Instant> {
+                <$engine>::poll_timeout(self)
+            }
+            fn is_done(&self) -> bool {
+                <$engine>::is_done(self)
+            }
+        }
+    };
+}
+
+broadcasts!(Discovery, Discovery::on_message);
+broadcasts!(Rounds, Rounds::on_message);
+// A read in slots answers nothing.
+broadcasts!(ReadAll, |r: &mut ReadAll, a, m| {
+    r.on_message(a, m);
+    None
+});
+
+impl Job for Round {
+    fn poll(&mut self, now: Instant) -> Option<Request> {
+        Round::poll(self, now)
+    }
+    fn on_answer(&mut self, _: Instant, answer: Result<Message, String>) {
+        Round::on_answer(self, answer)
+    }
+    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+        Round::hear(self, address, message)
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        Round::poll_timeout(self)
+    }
+    fn is_done(&self) -> bool {
+        Round::is_done(self)
+    }
+}
+
+impl Job for Update {
+    fn poll(&mut self, now: Instant) -> Option<Request> {
+        Update::poll(self, now)
+    }
+    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
+        Update::on_answer(self, now, answer)
+    }
+    fn hear(&mut self, _: Address, _: &Message) -> Option<AppFrame> {
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        Update::poll_timeout(self)
+    }
+    fn is_done(&self) -> bool {
+        Update::is_done(self)
+    }
+}
+
+/// One request and its fate: the job of asking one board one thing.
+#[derive(Debug, Clone)]
+pub struct Ask {
+    request: Option<Request>,
+    /// The answer, or why there is none; `None` while it is awaited, and
+    /// for a request that expects no answer.
+    pub answer: Option<Result<Message, String>>,
+}
+
+impl Ask {
+    /// Asks `request`.
+    pub fn new(request: Request) -> Ask {
+        Ask {
+            request: Some(request),
+            answer: None,
+        }
+    }
+}
+
+impl Job for Ask {
+    fn poll(&mut self, _: Instant) -> Option<Request> {
+        self.request.take()
+    }
+    fn on_answer(&mut self, _: Instant, answer: Result<Message, String>) {
+        self.answer = Some(answer);
+    }
+    fn hear(&mut self, _: Address, _: &Message) -> Option<AppFrame> {
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        None
+    }
+    fn is_done(&self) -> bool {
+        self.request.is_none()
+    }
+}
+
+/// A job run on a concentrator.
+#[derive(Debug, Clone)]
+pub struct Run<J> {
+    job: J,
+    /// The job's request whose fate is awaited.
+    awaiting: Option<RequestId>,
+}
+
+impl<J: Job> Run<J> {
+    /// Runs `job`.
+    pub fn new(job: J) -> Self {
+        Run {
+            job,
+            awaiting: None,
+        }
+    }
+
+    /// The job.
+    pub fn job(&self) -> &J {
+        &self.job
+    }
+
+    /// The job, to act on it (abort an update, ...).
+    pub fn job_mut(&mut self) -> &mut J {
+        &mut self.job
+    }
+
+    /// The job, once it is over.
+    pub fn into_job(self) -> J {
+        self.job
+    }
+
+    /// Submits the job's next request, if one is due now and the last
+    /// one's fate is known. Returns its id.
+    pub fn pump(&mut self, conc: &mut Concentrator, now: Instant) -> Option<RequestId> {
+        if self.awaiting.is_some() {
+            return None;
+        }
+        let request = self.job.poll(now)?;
+        let id = conc.submit(now, request);
+        self.awaiting = Some(id);
+        Some(id)
+    }
+
+    /// A happening of the concentrator: the fate of the job's request, or
+    /// a frame a board sent unasked (the job's answer to it is sent).
+    /// Returns whether it was the job's.
+    pub fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening) -> bool {
+        let Happening::App(e) = h else {
+            return false;
+        };
+        if let AppEvent::Unsolicited {
+            address, message, ..
+        } = e
+        {
+            if let Some(reply) = self.job.hear(*address, message) {
+                conc.send(now, reply);
+            }
+            return true;
+        }
+        if self.awaiting.is_none() || e.fate_of() != self.awaiting {
+            return false;
+        }
+        self.awaiting = None;
+        match e {
+            AppEvent::Answered { answer, .. } => self.job.on_answer(now, Ok(answer.clone())),
+            AppEvent::Failed { reason, .. } => self.job.on_answer(now, Err(reason.clone())),
+            // Sent, and no answer expected.
+            _ => {}
+        }
+        true
+    }
+
+    /// When [`Run::pump`] is due for time.
+    pub fn poll_timeout(&self) -> Option<Instant> {
+        self.awaiting
+            .map_or_else(|| self.job.poll_timeout(), |_| None)
+    }
+
+    /// Whether the job is over, its last request's fate known.
+    pub fn is_done(&self) -> bool {
+        self.awaiting.is_none() && self.job.is_done()
+    }
+}
+
+/// The loop of every street driver: runs `run` on `conc` over `io` until
+/// the job is over or `limit` is reached (returns whether it is over).
+/// `each` is called after every turn with its time and its happenings
+/// (often none), which the job has already had.
+pub fn drive<J: Job, I: Io + ?Sized>(
+    run: &mut Run<J>,
+    conc: &mut Concentrator,
+    io: &mut I,
+    limit: Instant,
+    mut each: impl FnMut(&mut Run<J>, Instant, &[Happening]) -> Result<(), I::Error>,
+) -> Result<bool, I::Error> {
+    let mut seen = alloc::vec::Vec::new();
+    loop {
+        let now = io.now();
+        run.pump(conc, now);
+        // What the turn brought, and what came of the request just
+        // submitted (a broadcast is sent at once).
+        while let Some(h) = conc.poll_happening() {
+            run.handle(conc, now, &h);
+            seen.push(h);
+        }
+        each(run, now, &seen)?;
+        if !seen.is_empty() {
+            seen.clear();
+            continue;
+        }
+        if run.is_done() || now >= limit {
+            drive::flush(conc, io)?;
+            return Ok(run.is_done());
+        }
+        let until = run.poll_timeout().map_or(limit, |t| t.min(limit));
+        drive::turn(conc, io, until, |_, _| {})?;
+    }
+}
+
+/// Submits `request` and runs until its fate (answered, failed, or sent
+/// when it expects no answer) or until `limit` has passed: one request of
+/// a driver that waits for it. `each` sees every happening on the way.
+pub fn fate<I: Io + ?Sized>(
+    conc: &mut Concentrator,
+    io: &mut I,
+    request: Request,
+    limit: crate::time::Duration,
+    mut each: impl FnMut(Instant, &Happening),
+) -> Result<Option<AppEvent>, I::Error> {
+    let id = conc.submit(io.now(), request);
+    let until = io.now() + limit;
+    // A turn first, even when the fate is known at once (a broadcast is
+    // "sent" as it is queued): the request's bytes go out, and the port
+    // is read, before the caller moves on (a process that exits with
+    // bytes unread on its socket resets the connection, and what it wrote
+    // last may be lost).
+    while io.now() < until {
+        let now = drive::turn(conc, io, until, |_, _| {})?;
+        while let Some(h) = conc.poll_happening() {
+            each(now, &h);
+            if let Happening::App(e) = h {
+                if e.fate_of() == Some(id) {
+                    return Ok(Some(e));
+                }
+            }
+        }
+    }
+    Ok(None)
+}
