@@ -23,6 +23,12 @@
 //   simulator and the concentrator, not the views: `plmBench.streetWork`),
 //   against the 5× target.
 //
+// - ACK latency on the street over a bare simulated ST7580
+//   (`?profile=concentrator&lamps=100`): the console is the concentrator,
+//   its host engine ACKs the modem's frames on the same drive loop as the
+//   modem session; while discovery runs and while the sweep reads, the
+//   Street view on screen, then the sweep with the Traffic table on screen.
+//
 // The page is driven through `window.plmBench` (crates/plm-console/src/
 // bench_hook.rs), so the figures are the session's, not a script's clicks.
 // PLM_DIST (another build directory), PLM_BENCH_READS (default 300) and
@@ -366,6 +372,53 @@ async function modemBench(browser, base, chip) {
   return { chip, queued, chained, ack, traffic, trafficReads, noise, causes, load, parts };
 }
 
+/** Lamps of the street whose bare modem's ACKs are timed. */
+const STREET_ACK_LAMPS = 100;
+
+/**
+ * ACK latency of the console as the concentrator of a street over a bare
+ * simulated ST7580, each window STREET_MEASURE_MS / 2 long: during
+ * discovery and during the sweep with the Street view on screen, then
+ * the sweep with the Traffic table on screen.
+ */
+async function streetAckBench(browser, base) {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  const errors = pageErrors(page);
+  await page.goto(base + `?profile=concentrator&lamps=${STREET_ACK_LAMPS}#street`);
+  await page.locator('#fleet-table').waitFor();
+  await page.waitForFunction(() => window.plmBench !== undefined);
+  const window_ = () => page.waitForTimeout(STREET_MEASURE_MS / 2);
+  const progress = () => page.textContent('#street-progress');
+  const discoveryWas = await progress();
+  const discovery = await ackSpreadOf(page, window_);
+  await page.waitForFunction(() => /^reading/.test(document.querySelector('#street-progress')?.textContent ?? ''), null, {
+    timeout: 900_000,
+    polling: 500,
+  });
+  const sweepWas = await progress();
+  const sweep = await ackSpreadOf(page, window_);
+  await page.click('#tab-traffic');
+  const traffic = await ackSpreadOf(page, window_);
+  const ack = await page.evaluate(() => window.plmBench.ackLatency());
+  await page.screenshot({ path: path.join(artifacts, 'bench-street-concentrator.png') });
+  await page.close();
+  if (errors.length) throw new Error(`errors in the street page: ${errors.join('; ')}`);
+  return { discovery, discoveryWas, sweep, sweepWas, traffic, ack };
+}
+
+/** The report's lines for the street over a bare modem. */
+function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack }, spread) {
+  const ratio = (s) => `ratio ${(s.p99 / ACK_P99_MS).toFixed(2)} of the ${ACK_P99_MS} ms p99 target`;
+  return [
+    '',
+    `Street of ${STREET_ACK_LAMPS} lamps over a bare ST7580, simulated (the console the concentrator; ${ack.count} frames ACKed; T_ACK ${ack.tAck} ms), page's clock:`,
+    `  discovery      ${spread(discovery)}   (${ratio(discovery)}; ${discovery.n} frames, Street view; from "${discoveryWas}")`,
+    `  sweep          ${spread(sweep)}   (${ratio(sweep)}; ${sweep.n} frames, Street view; from "${sweepWas}")`,
+    `  Traffic view   ${spread(traffic)}   (${ratio(traffic)}; ${traffic.n} frames of the sweep, the Traffic table on screen)`,
+    `  virtual link   ${spread(ack.link)}   (what the simulated modem saw, all frames)`,
+  ];
+}
+
 /** ACK latency on the page's clock of the frames ACKed while `run` runs. */
 async function ackSpreadOf(page, run) {
   const before = await page.evaluate(() => window.plmBench.ackLatency().count);
@@ -407,6 +460,7 @@ async function main() {
   try {
     const modems = [];
     for (const chip of CHIPS) modems.push(await modemBench(browser, base, chip));
+    const streetAck = await streetAckBench(browser, base);
     const street = process.env.PLM_BENCH_STREET === '0' ? null : await streetFrames(browser, base);
 
     const dsizes = await sizes();
@@ -421,6 +475,7 @@ async function main() {
       '',
       `PLM Console, Chromium ${browser.version()}, simulated modems at ${BAUD} baud`,
       ...modems.flatMap((m) => modemLines(m, spread)),
+      ...streetAckLines(streetAck, spread),
       '',
       ...(street
         ? [

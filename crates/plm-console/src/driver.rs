@@ -11,7 +11,10 @@ pub mod ack;
 
 use crate::transport::Transport;
 use ack::{AckLatency, AckTimes};
+use plm_core::app::Happening;
 use plm_core::drive::{self, Engine, Io};
+use plm_core::link::host::{Event, HostEngine};
+use plm_core::link::Element;
 use plm_core::time::{Duration, Instant, MS};
 use std::convert::Infallible;
 
@@ -209,20 +212,62 @@ impl Driver {
     }
 }
 
+/// The engine of any session, as the driver sees it: its events are the
+/// concentrator's [`Happening`]s, a host link engine's being
+/// [`Happening::Link`] ([`HostLink`]). One type, so that the loop below
+/// is compiled once for every session.
+pub type AnyEngine = dyn Engine<Event = Happening>;
+
+/// A host link engine whose events are [`Happening::Link`].
+pub struct HostLink(pub HostEngine);
+
+impl Engine for HostLink {
+    type Event = Happening;
+    fn handle_rx(&mut self, at: Instant, bytes: &[u8]) {
+        self.0.handle_rx(at, bytes)
+    }
+    fn handle_timeout(&mut self, now: Instant) {
+        self.0.handle_timeout(now)
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        self.0.poll_timeout()
+    }
+    fn poll_transmit(&mut self) -> Option<plm_core::drive::Transmit> {
+        self.0.poll_transmit()
+    }
+    fn poll_event(&mut self) -> Option<Happening> {
+        self.0.poll_event().map(Happening::Link)
+    }
+}
+
+impl std::ops::Deref for HostLink {
+    type Target = HostEngine;
+    fn deref(&self) -> &HostEngine {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for HostLink {
+    fn deref_mut(&mut self) -> &mut HostEngine {
+        &mut self.0
+    }
+}
+
+/// Whether `event` is an ACK the host engine wrote to a modem's frame.
+fn is_ack(event: &Happening) -> bool {
+    matches!(event, Happening::Link(Event::Sent(Element::Ack)))
+}
+
 /// A session on the driver: an engine and what the session does with it.
 pub trait Layer {
-    /// The sans-IO engine on the transport.
-    type Engine: Engine;
     /// Whether the engine ACKs a modem's frames (a host link engine):
     /// its ACKs are timed, and a simulated modem's time trails the page
     /// little ([`catch_up`]).
     fn acks(&self) -> bool;
     /// The engine and the driver, borrowed together.
-    fn parts(&mut self) -> (&mut Self::Engine, &mut Driver);
-    /// Whether `event` is an ACK the engine wrote.
-    fn is_ack(event: &<Self::Engine as Engine>::Event) -> bool;
+    fn parts(&mut self) -> (&mut AnyEngine, &mut Driver);
     /// An event of the engine, at the instant it happened.
-    fn on_event(&mut self, at: Instant, event: <Self::Engine as Engine>::Event);
+    fn on_event(&mut self, at: Instant, event: Happening);
     /// T_REQ was set on the transport.
     fn on_treq(&mut self, _asserted: bool) {}
     /// The next instant the engine, the world behind the transport or the
@@ -231,7 +276,9 @@ pub trait Layer {
     /// The next instant the link or the world behind the transport does
     /// something of its own (a request waiting to be sent left out):
     /// until then time passes whole ([`Pacer::target_within`]).
-    fn world_due(&self) -> Option<Instant>;
+    fn world_due(&self) -> Option<Instant> {
+        self.next_due()
+    }
     /// Whether time may run straight to `target`: nothing in flight and
     /// nothing due before it.
     fn idle_until(&self, _target: Instant) -> bool {
@@ -277,7 +324,7 @@ impl Io for Port<'_> {
 
 /// Lets the transport's time catch up with the page's clock `page_us`
 /// (µs, any origin), within `budget`.
-pub fn tick<L: Layer>(layer: &mut L, page_us: f64, budget: Budget) {
+pub fn tick(layer: &mut dyn Layer, page_us: f64, budget: Budget) {
     let acks = layer.acks();
     let busy = layer.world_due();
     let (_, d) = layer.parts();
@@ -305,10 +352,8 @@ pub fn tick<L: Layer>(layer: &mut L, page_us: f64, budget: Budget) {
 /// budget allows: in steps of at most [`SLICE`], straight to whatever is
 /// due next, so that a byte is taken, and ACKed, at the instant it
 /// arrives (UM0932 3.2.8, T_ACK).
-pub fn run_within<L: Layer>(layer: &mut L, start: Instant, target: Instant, budget: Budget) {
+pub fn run_within(layer: &mut dyn Layer, start: Instant, target: Instant, budget: Budget) {
     let mut t = start;
-    let mut events = Vec::new();
-    let mut treq = Vec::new();
     while t < target && !budget.spent() {
         let mut next = (t + SLICE).min(target);
         if let Some(d) = layer.next_due().filter(|d| *d > t && *d < next) {
@@ -317,6 +362,7 @@ pub fn run_within<L: Layer>(layer: &mut L, start: Instant, target: Instant, budg
         if layer.idle_until(target) {
             next = target;
         }
+        let (mut events, mut treq) = (Vec::new(), Vec::new());
         let (engine, d) = layer.parts();
         let Some(transport) = d.transport.as_deref_mut() else {
             return;
@@ -328,8 +374,7 @@ pub fn run_within<L: Layer>(layer: &mut L, start: Instant, target: Instant, budg
         let Ok(now) = drive::turn(engine, &mut port, next, |e, at| {
             events.extend(std::iter::from_fn(|| e.poll_event()).map(|ev| (at, ev)));
         });
-        events.extend(std::iter::from_fn(|| engine.poll_event()).map(|ev| (now, ev)));
-        hand_over(layer, &mut events, &mut treq);
+        hand_over(layer, events, treq, now);
         layer.at(now);
         flush(layer, now);
         t = if now > t { now } else { next };
@@ -341,35 +386,38 @@ pub fn run_within<L: Layer>(layer: &mut L, start: Instant, target: Instant, budg
 
 /// Writes now what the session gave the engine, and hands the events it
 /// caused to the session.
-pub fn flush<L: Layer>(layer: &mut L, now: Instant) {
+pub fn flush(layer: &mut dyn Layer, now: Instant) {
     let mut treq = Vec::new();
     let (engine, d) = layer.parts();
     if let Some(transport) = d.transport.as_deref_mut() {
-        let mut port = Port {
-            transport,
-            treq: &mut treq,
-        };
-        let Ok(()) = drive::flush(engine, &mut port);
+        let Ok(()) = drive::flush(
+            engine,
+            &mut Port {
+                transport,
+                treq: &mut treq,
+            },
+        );
     }
-    let mut events: Vec<_> = std::iter::from_fn(|| engine.poll_event())
-        .map(|ev| (now, ev))
-        .collect();
-    hand_over(layer, &mut events, &mut treq);
+    hand_over(layer, Vec::new(), treq, now);
 }
 
-/// The turn's T_REQ levels and events to the session, in order, each ACK
+/// T_REQ levels set and the engine's events (`events`, each at its byte's
+/// arrival, then the rest at `now`) to the session, in order, each ACK
 /// timed.
-fn hand_over<L: Layer>(
-    layer: &mut L,
-    events: &mut Vec<(Instant, <L::Engine as Engine>::Event)>,
-    treq: &mut Vec<bool>,
+fn hand_over(
+    layer: &mut dyn Layer,
+    mut events: Vec<(Instant, Happening)>,
+    treq: Vec<bool>,
+    now: Instant,
 ) {
-    for asserted in treq.drain(..) {
+    let (engine, _) = layer.parts();
+    events.extend(std::iter::from_fn(|| engine.poll_event()).map(|ev| (now, ev)));
+    for asserted in treq {
         layer.on_treq(asserted);
     }
     let acks = layer.acks();
-    for (at, e) in events.drain(..) {
-        if acks && L::is_ack(&e) {
+    for (at, e) in events {
+        if acks && is_ack(&e) {
             layer.parts().1.acked(at);
         }
         layer.on_event(at, e);

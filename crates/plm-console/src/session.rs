@@ -22,8 +22,9 @@
 //!   ACK written, against T_ACK (UM0932 3.2.8).
 
 use crate::driver::ack::AckLatency;
-use crate::driver::{self, earliest, Budget, Driver, Layer};
+use crate::driver::{self, earliest, AnyEngine, Budget, Driver, HostLink, Layer};
 use crate::transport::{LinkState, Transport};
+use plm_core::app::Happening;
 use plm_core::chip::{self, Chip};
 use plm_core::decode::Decoded;
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket};
@@ -170,7 +171,7 @@ struct Active {
 pub struct Session {
     /// The transport, the page's clock on it, the ACK latency.
     drive: Driver,
-    host: HostEngine,
+    host: HostLink,
     /// The chip's host interface, with its decoding context.
     chip: Box<dyn Chip>,
     queue: VecDeque<Queued>,
@@ -203,7 +204,10 @@ impl Session {
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
         let mut s = Session {
             drive: Driver::new(transport),
-            host: HostEngine::new(dialect, HostConfig::at_reset(dialect, baud)),
+            host: HostLink(HostEngine::new(
+                dialect,
+                HostConfig::at_reset(dialect, baud),
+            )),
             chip: chip::for_dialect(dialect),
             queue: VecDeque::new(),
             active: None,
@@ -281,7 +285,10 @@ impl Session {
         let ended = self.log_time(self.now());
         let baud = transport.as_ref().map_or(57_600, |t| t.baud());
         self.log_offset = ended as i64 - transport.as_ref().map_or(0, |t| t.now()) as i64;
-        self.host = HostEngine::new(dialect, HostConfig::at_reset(dialect, baud));
+        self.host = HostLink(HostEngine::new(
+            dialect,
+            HostConfig::at_reset(dialect, baud),
+        ));
         self.chip = chip::for_dialect(dialect);
         self.drive = Driver::new(transport);
         self.timeouts = Timeouts::at_reset(dialect, baud);
@@ -319,6 +326,11 @@ impl Session {
     /// what held up the late ones).
     pub fn ack_samples(&self) -> Vec<(f64, Duration, Duration)> {
         self.drive.ack_samples()
+    }
+
+    /// Its drive loop.
+    pub fn driver(&self) -> &Driver {
+        &self.drive
     }
 
     /// Requests not yet answered (the one outstanding and those queued).
@@ -637,7 +649,7 @@ impl Session {
             self.out
                 .replies
                 .push((a.reply, Outcome::Failed(why.to_string())));
-            self.host = HostEngine::new(self.chip.dialect(), self.host.config());
+            self.host = HostLink(HostEngine::new(self.chip.dialect(), self.host.config()));
             if let Some(t) = self.drive.transport.as_mut() {
                 t.set_treq(false);
             }
@@ -654,22 +666,18 @@ impl Session {
 
 /// The modem session on the console's one drive loop.
 impl Layer for Session {
-    type Engine = HostEngine;
-
     fn acks(&self) -> bool {
         true
     }
 
-    fn parts(&mut self) -> (&mut HostEngine, &mut Driver) {
+    fn parts(&mut self) -> (&mut AnyEngine, &mut Driver) {
         (&mut self.host, &mut self.drive)
     }
 
-    fn is_ack(event: &Event) -> bool {
-        matches!(event, Event::Sent(Element::Ack))
-    }
-
-    fn on_event(&mut self, at: Instant, event: Event) {
-        self.on_event(at, event)
+    fn on_event(&mut self, at: Instant, event: Happening) {
+        if let Happening::Link(e) = event {
+            self.on_event(at, e)
+        }
     }
 
     fn on_treq(&mut self, asserted: bool) {

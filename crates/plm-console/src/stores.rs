@@ -3,7 +3,8 @@
 //! session's [`Note`]s to them.
 
 use crate::clock::page_now_us;
-use crate::driver::{Budget, TICK_BUDGET_US};
+use crate::driver::ack::AckLatency;
+use crate::driver::{Budget, Driver, TICK_BUDGET_US};
 use crate::history_store;
 use crate::profile::Profile;
 use crate::session::{Note, Outcome, Session, Tick};
@@ -632,14 +633,25 @@ impl Console {
         self.refresh();
     }
 
-    /// How quickly the host has ACKed the modem's frames since connecting.
-    pub fn ack_latency(&self) -> crate::driver::ack::AckLatency {
-        self.session().borrow().ack_latency()
+    /// The drive loop of the profile in use.
+    fn with_driver<R>(&self, f: impl FnOnce(&Driver) -> R) -> R {
+        if self.profile.get_untracked().is_street() {
+            f(self.street.session().borrow().driver())
+        } else {
+            f(self.session().borrow().driver())
+        }
     }
 
-    /// [`crate::session::Session::ack_samples`].
+    /// How quickly the console has ACKed the modem's frames since
+    /// connecting (the bare modem of the street's concentrator profile
+    /// included).
+    pub fn ack_latency(&self) -> AckLatency {
+        self.with_driver(Driver::ack_latency)
+    }
+
+    /// [`Driver::ack_samples`].
     pub fn ack_samples(&self) -> Vec<(f64, plm_core::time::Duration, plm_core::time::Duration)> {
-        self.session().borrow().ack_samples()
+        self.with_driver(Driver::ack_samples)
     }
 
     /// Lets time pass up to the page's clock, then asks to be run again

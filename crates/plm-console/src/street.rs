@@ -10,7 +10,7 @@ mod campaign;
 
 pub use campaign::Campaign;
 
-use crate::driver::{self, earliest, Budget, Driver, Layer};
+use crate::driver::{self, earliest, AnyEngine, Budget, Driver, Layer};
 use crate::transport::{LinkState, Transport};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::energy::Meter;
@@ -237,10 +237,10 @@ impl StreetSession {
         self.drive.work()
     }
 
-    /// How quickly the console ACKs the bare modem's frames (none through
-    /// a board, which ACKs its modem itself).
-    pub fn ack_latency(&self) -> crate::driver::ack::AckLatency {
-        self.drive.ack_latency()
+    /// Its drive loop: how quickly the console ACKs the bare modem's
+    /// frames (none through a board, which ACKs its modem itself).
+    pub fn driver(&self) -> &Driver {
+        &self.drive
     }
 
     /// The lamps known so far.
@@ -281,7 +281,8 @@ impl StreetSession {
         self.found_before_frame = 0;
         self.out.found = true;
         self.conc.submit(now, first);
-        driver::flush(self, self.now());
+        let now = self.now();
+        driver::flush(self, now);
     }
 
     /// Numbers the sessions of the discoveries to come from `last` on
@@ -402,7 +403,8 @@ impl StreetSession {
         }
         let id = self.conc.submit(now, request);
         self.purposes.push((id, purpose));
-        driver::flush(self, self.now());
+        let now = self.now();
+        driver::flush(self, now);
     }
 
     /// Whether the round's lamps (or new boards) may be answering now.
@@ -430,7 +432,8 @@ impl StreetSession {
         if let LinkState::Disconnected(why) = self.state() {
             if self.conc.requester().pending() > 0 {
                 self.conc.abort_all(&why);
-                self.handle_happenings();
+                let now = self.now();
+                driver::flush(self, now);
             }
         }
         driver::tick(self, page_us, budget);
@@ -592,13 +595,6 @@ impl StreetSession {
         lamp.last_seen = Some(now);
         self.out.changed = true;
         self.out.found = true;
-    }
-
-    fn handle_happenings(&mut self) {
-        let now = self.now();
-        while let Some(h) = self.conc.poll_happening() {
-            self.on_happening(now, h);
-        }
     }
 
     fn on_happening(&mut self, now: Instant, h: Happening) {
@@ -783,20 +779,14 @@ impl StreetSession {
 
 /// The street on the console's one drive loop.
 impl Layer for StreetSession {
-    type Engine = Concentrator;
-
     /// Through a bare modem the console's host engine ACKs its frames;
     /// through a board, the board does.
     fn acks(&self) -> bool {
         self.via_modem()
     }
 
-    fn parts(&mut self) -> (&mut Concentrator, &mut Driver) {
+    fn parts(&mut self) -> (&mut AnyEngine, &mut Driver) {
         (&mut self.conc, &mut self.drive)
-    }
-
-    fn is_ack(h: &Happening) -> bool {
-        matches!(h, Happening::Link(host::Event::Sent(Element::Ack)))
     }
 
     fn on_event(&mut self, at: Instant, h: Happening) {
@@ -804,10 +794,6 @@ impl Layer for StreetSession {
     }
 
     fn next_due(&self) -> Option<Instant> {
-        StreetSession::next_due(self)
-    }
-
-    fn world_due(&self) -> Option<Instant> {
         StreetSession::next_due(self)
     }
 

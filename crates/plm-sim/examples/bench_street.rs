@@ -28,7 +28,7 @@ use plm_core::app::discovery::{DiscoveryConfig, Timing};
 use plm_core::app::hid::{self, Hid};
 use plm_core::app::read_all::ReadConfig;
 use plm_core::app::service::{Discovered, Release, Service};
-use plm_core::app::{Address, LineFrame, Message, RequesterConfig};
+use plm_core::app::{Address, Job, LineFrame, Message, Request, RequesterConfig};
 use plm_core::st7580::mib::{index, object, PhyConfig};
 use plm_core::st7580::{Modulation, TxParams};
 use plm_core::time::{Duration, MS};
@@ -149,29 +149,14 @@ fn update_one(modulation: Modulation) {
     let start = d.now();
     let mut u =
         Update::new(1, new, image.clone(), &[street_address(1)], config).expect("a campaign");
-    // The engine's loop (StreetDriver::update), noting when the image is
-    // across: the swap asked.
-    let mut across = None;
-    while !u.is_done() {
-        let now = d.now();
-        match u.poll(now) {
-            Some(r) => {
-                if matches!(r.message, Message::Service(Service::RfuSwap { .. })) {
-                    across.get_or_insert(now);
-                }
-                let answer = d.request(r, 120 * S);
-                if let Some(plm_core::app::AppEvent::Answered { answer, .. }) = answer {
-                    u.on_answer(d.now(), Ok(answer));
-                } else if let Some(plm_core::app::AppEvent::Failed { reason, .. }) = answer {
-                    u.on_answer(d.now(), Err(reason));
-                }
-            }
-            None => {
-                let until = u.poll_timeout().unwrap_or(now + 100 * MS);
-                d.run_for(until.saturating_sub(now).max(1));
-            }
-        }
-    }
+    // The campaign run as StreetDriver::update runs it, noting when the
+    // image is across: the swap asked.
+    let mut noting = Noting {
+        update: &mut u,
+        across: None,
+    };
+    d.run_job(&mut noting, 3_600 * S);
+    let across = noting.across;
     let took = (d.now() - start) as f64 / 1e6;
     let transfer = (across.unwrap_or(d.now()) - start) as f64 / 1e6;
     let done = u.boards().all(|(_, s)| *s == BoardState::Done);
@@ -194,6 +179,36 @@ fn update_one(modulation: Modulation) {
         if done { "updated" } else { "NOT updated" },
         wall.elapsed().as_secs_f64()
     );
+}
+
+/// A campaign that notes when it first asks a board to swap.
+struct Noting<'a> {
+    update: &'a mut plm_core::app::update::Update,
+    across: Option<plm_core::time::Instant>,
+}
+
+impl Job for Noting<'_> {
+    fn poll(&mut self, now: plm_core::time::Instant) -> Option<Request> {
+        let r = self.update.poll(now);
+        if r.as_ref()
+            .is_some_and(|r| matches!(r.message, Message::Service(Service::RfuSwap { .. })))
+        {
+            self.across.get_or_insert(now);
+        }
+        r
+    }
+    fn on_answer(&mut self, now: plm_core::time::Instant, answer: Result<Message, String>) {
+        self.update.on_answer(now, answer)
+    }
+    fn hear(&mut self, a: Address, m: &Message) -> Option<plm_core::app::AppFrame> {
+        Job::hear(&mut *self.update, a, m)
+    }
+    fn poll_timeout(&self) -> Option<plm_core::time::Instant> {
+        self.update.poll_timeout()
+    }
+    fn is_done(&self) -> bool {
+        self.update.is_done()
+    }
 }
 
 /// A street's line-time targets, s (docs/architecture.md, "Performance

@@ -519,7 +519,7 @@ impl Board {
         if let Some(a) = self.rfu.handle(now, s, rng) {
             return match a {
                 _ if broadcast => None,
-                rfu::Answer::Ack => Some(Message::Service(s.clone()).ack()),
+                rfu::Answer::Ack => Some(Message::ack_of(s)),
                 rfu::Answer::Refused => Some(Message::Error(ErrorCode::SERVICE_CMD_ERROR)),
                 rfu::Answer::Reply(r) => Some(Message::Service(r)),
                 rfu::Answer::Nothing => None,
@@ -535,7 +535,7 @@ impl Board {
             };
             return Some(Message::Error(code));
         }
-        let ack = Some(Message::Service(s.clone()).ack());
+        let ack = Some(Message::ack_of(s));
         let reply = |s: Service| Some(Message::Service(s));
         match s {
             Service::SoftwareReset => {

@@ -77,12 +77,18 @@ impl Breach {
     /// request that did not parse) instead of `answer`.
     pub fn answer(self, request: Option<&Message>, answer: Option<Message>) -> Option<Message> {
         let refused = Message::Error(ErrorCode::SERVICE_CMD_ERROR);
+        // The error code compared, not the whole message: the page would
+        // carry a comparison of every message for these two.
+        let is_refused =
+            |a: &Message| matches!(a, Message::Error(c) if *c == ErrorCode::SERVICE_CMD_ERROR);
         let service = match request {
             Some(Message::Service(s)) => Some(s),
             _ => None,
         };
         match (self, service, answer) {
-            (Breach::ErrorFrame, None | Some(Service::Raw { .. }), Some(a)) if a == refused => None,
+            (Breach::ErrorFrame, None | Some(Service::Raw { .. }), Some(a)) if is_refused(&a) => {
+                None
+            }
             (Breach::Status, _, Some(Message::Service(Service::RfuStatus(mut s)))) => {
                 s.bitmap.pop();
                 Some(Message::Service(Service::RfuStatus(s)))
@@ -96,8 +102,8 @@ impl Breach {
             (Breach::Header, Some(Service::RfuHeader(_)), Some(Message::Ack { .. })) => {
                 Some(refused)
             }
-            (Breach::Swap, Some(s @ Service::RfuSwap { .. }), Some(a)) if a == refused => {
-                Some(Message::Service(s.clone()).ack())
+            (Breach::Swap, Some(s @ Service::RfuSwap { .. }), Some(a)) if is_refused(&a) => {
+                Some(Message::ack_of(s))
             }
             (Breach::Abort, Some(Service::RfuAbort { .. }), Some(Message::Ack { .. })) => {
                 Some(refused)

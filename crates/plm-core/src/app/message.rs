@@ -200,9 +200,21 @@ impl Message {
     /// echo being the first payload byte (the service command, `'s'`)
     /// or 0 for a ping (4.6.2, 4.6.4, Appendix A).
     pub fn ack(&self) -> Message {
+        if let Message::Service(s) = self {
+            return Message::ack_of(s);
+        }
         Message::Ack {
             frame_type: self.frame_type(),
             echo: self.payload().first().copied().unwrap_or(0),
+        }
+    }
+
+    /// [`Message::ack`] of the service request `s`, without the message:
+    /// its echo is the command byte, the payload's first.
+    pub fn ack_of(s: &Service) -> Message {
+        Message::Ack {
+            frame_type: FrameType::Service,
+            echo: s.command(),
         }
     }
 
