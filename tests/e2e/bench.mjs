@@ -408,14 +408,15 @@ async function streetAckBench(browser, base) {
 
 /** The report's lines for the street over a bare modem. */
 function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack }, spread) {
-  const ratio = (s) => `ratio ${(s.p99 / ACK_P99_MS).toFixed(2)} of the ${ACK_P99_MS} ms p99 target`;
+  const ratio = (s) => (s.n ? `ratio ${(s.p99 / ACK_P99_MS).toFixed(2)} of the ${ACK_P99_MS} ms p99 target` : 'no frame ACKed');
+  const line = (s) => (s.n ? spread(s) : 'none');
   return [
     '',
     `Street of ${STREET_ACK_LAMPS} lamps over a bare ST7580, simulated (the console the concentrator; ${ack.count} frames ACKed; T_ACK ${ack.tAck} ms), page's clock:`,
-    `  discovery      ${spread(discovery)}   (${ratio(discovery)}; ${discovery.n} frames, Street view; from "${discoveryWas}")`,
-    `  sweep          ${spread(sweep)}   (${ratio(sweep)}; ${sweep.n} frames, Street view; from "${sweepWas}")`,
-    `  Traffic view   ${spread(traffic)}   (${ratio(traffic)}; ${traffic.n} frames of the sweep, the Traffic table on screen)`,
-    `  virtual link   ${spread(ack.link)}   (what the simulated modem saw, all frames)`,
+    `  discovery      ${line(discovery)}   (${ratio(discovery)}; ${discovery.n} frames, Street view; from "${discoveryWas}")`,
+    `  sweep          ${line(sweep)}   (${ratio(sweep)}; ${sweep.n} frames, Street view; from "${sweepWas}")`,
+    `  Traffic view   ${line(traffic)}   (${ratio(traffic)}; ${traffic.n} frames of the sweep, the Traffic table on screen)`,
+    `  virtual link   ${ack.count ? spread(ack.link) : 'none'}   (what the simulated modem saw, all frames)`,
   ];
 }
 
