@@ -38,7 +38,7 @@ fn benches() -> Vec<Bench> {
             needs_dist: false,
         },
         Bench {
-            name: "simulator speed and MIB-read rate (native)",
+            name: "simulator speed, MIB-read rate, reads behind a USB-UART latency timer (native)",
             sources: &["crates/plm-sim/examples/bench_sim.rs"],
             cmd: Cmd::new("cargo").args([
                 "run",

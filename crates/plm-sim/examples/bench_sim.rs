@@ -10,6 +10,11 @@
 //!    wire-time limit: the bytes one MIB_ReadRequest exchange puts on the
 //!    UART (status message, request, ACK, confirm, ACK) at 10 bits a byte,
 //!    with nothing between them.
+//! 3. The same reads through a USB-UART adapter's receive latency (an FTDI
+//!    chip's default 16 ms latency timer, [`plm_sim::UsbUart`]) on
+//!    plm-core's drive loop: every read answered, the retries counted, and
+//!    the ACK latency the modem sees (its frame's last byte at the adapter
+//!    to the host's ACK) against T_ACK.
 
 use plm_core::link::host::Event;
 use plm_core::link::Dialect;
@@ -73,6 +78,34 @@ fn mib_reads() -> (f64, f64) {
     (rate, limit)
 }
 
+/// The FTDI default latency timer.
+const FTDI_LATENCY: u64 = 16 * MS;
+
+/// MIB reads behind a USB-UART: (reads, answered, retries, ACK latencies
+/// as the modem sees them, reads per second).
+fn mib_reads_behind_usb() -> (usize, usize, usize, Vec<u64>, f64) {
+    let mut d = HostDriver::new(Sim::new(SimConfig::default())).behind_usb(FTDI_LATENCY);
+    d.run_for(100 * MS);
+    let read = Command::MibReadRequest { index: 0x0A };
+    let n = 500;
+    let start = d.now();
+    let mut answered = 0;
+    for _ in 0..n {
+        if let Outcome::Answer(Command::MibReadConfirm { .. }) = d.request(&read, 2_000 * MS) {
+            answered += 1;
+        }
+    }
+    let rate = n as f64 / ((d.now() - start) as f64 / 1e6);
+    let retries = d
+        .events
+        .iter()
+        .filter(|(_, e)| matches!(e, Event::Retry { .. }))
+        .count();
+    let mut acks = d.sim.acks.clone();
+    acks.sort_unstable();
+    (n, answered, retries, acks, rate)
+}
+
 fn main() {
     busy_line();
     let mut runs: Vec<_> = (0..5).map(|_| busy_line()).collect();
@@ -87,5 +120,20 @@ fn main() {
         "MIB reads at 57600 baud (host engine vs simulated modem, virtual time): \
          {rate:.1}/s, wire-time limit {limit:.1}/s, {:.0} % of the limit",
         100.0 * rate / limit
+    );
+    let (n, answered, retries, acks, rate) = mib_reads_behind_usb();
+    let at = |p: usize| acks[(acks.len() * p).div_ceil(100).max(1) - 1] as f64 / 1e3;
+    let t_ack = plm_core::link::Timeouts::at_reset(Dialect::St7580, 57_600).t_ack as f64 / 1e3;
+    println!(
+        "MIB reads through a USB-UART's {} ms receive latency (FTDI's default latency timer), \
+         plm-core's drive loop: {answered} of {n} answered, {retries} attempts repeated, {rate:.1}/s; \
+         ACK latency the modem sees ({} frames): p50 {:.1} ms, p99 {:.1} ms, max {:.1} ms, \
+         ratio {:.2} of T_ACK {t_ack:.0} ms",
+        FTDI_LATENCY / MS,
+        acks.len(),
+        at(50),
+        at(99),
+        acks.last().map_or(0.0, |&m| m as f64 / 1e3),
+        at(99) / t_ack,
     );
 }

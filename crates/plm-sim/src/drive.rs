@@ -36,11 +36,93 @@ impl Io for Sim {
     }
 }
 
-/// A host engine joined to a simulation.
+/// A USB-UART adapter between node 0's UART and the host, as an FTDI
+/// chip hands received bytes to USB: held until its latency timer runs
+/// out (16 ms by default, counted from the first byte held) or a packet
+/// is full ([`UsbUart::PACKET`] bytes), then delivered at once, each
+/// stamped with the time the host gets it. What the host writes goes
+/// straight to the modem. It keeps, for every ACK the host writes, how
+/// long after the acknowledged frame's last byte reached the adapter the
+/// ACK left the host: what the modem waits, against T_ACK (UM0932 3.2.8).
 #[derive(Debug, Clone)]
-pub struct HostDriver {
-    /// The simulation.
+pub struct UsbUart {
+    /// The simulation behind the adapter.
     pub sim: Sim,
+    /// The latency timer.
+    pub latency: Duration,
+    held: Vec<(Instant, u8)>,
+    /// When the last byte handed to the host reached the adapter.
+    last_in: Option<Instant>,
+    /// Each ACK's wait as the modem sees it.
+    pub acks: Vec<Duration>,
+}
+
+impl UsbUart {
+    /// Bytes of data in one USB packet of an FTDI chip (64 less its 2
+    /// status bytes).
+    pub const PACKET: usize = 62;
+
+    /// `sim` behind an adapter with latency timer `latency`.
+    pub fn new(sim: Sim, latency: Duration) -> Self {
+        UsbUart {
+            sim,
+            latency,
+            held: Vec::new(),
+            last_in: None,
+            acks: Vec::new(),
+        }
+    }
+
+    /// When the held bytes go to the host.
+    fn release_at(&self) -> Option<Instant> {
+        self.held.first().map(|(t, _)| t + self.latency)
+    }
+}
+
+impl Io for UsbUart {
+    type Error = Infallible;
+    fn now(&self) -> Instant {
+        self.sim.now()
+    }
+    fn wait(&mut self, until: Instant, rx: &mut Vec<(Instant, u8)>) -> Result<(), Infallible> {
+        let now = self.sim.now();
+        let until = self.release_at().map_or(until, |t| t.min(until));
+        let next = self
+            .sim
+            .next_deadline()
+            .unwrap_or(until)
+            .clamp(now, until.max(now));
+        self.sim.advance_to(next);
+        self.held.extend(self.sim.host_read());
+        let now = self.sim.now();
+        let full = self.held.len() >= Self::PACKET;
+        if full || self.release_at().is_some_and(|t| t <= now) {
+            self.last_in = self.held.last().map(|(t, _)| *t);
+            rx.extend(self.held.drain(..).map(|(_, b)| (now, b)));
+        }
+        Ok(())
+    }
+    fn write(&mut self, bytes: &[u8]) -> Result<(), Infallible> {
+        if bytes == [plm_core::link::ACK] {
+            if let Some(t) = self.last_in {
+                self.acks.push(self.sim.now() - t);
+            }
+        }
+        self.sim.write(bytes);
+        Ok(())
+    }
+    fn set_treq(&mut self, asserted: bool) -> Result<(), Infallible> {
+        self.sim.set_treq(asserted);
+        Ok(())
+    }
+}
+
+/// A host engine joined to a simulation (through `P`: node 0's UART
+/// itself, or a [`UsbUart`]).
+#[derive(Debug, Clone)]
+pub struct HostDriver<P = Sim> {
+    /// The simulation, or the adapter in front of it.
+    pub sim: P,
     /// The host's link engine.
     pub host: HostEngine,
     /// Every host event so far, with its time.
@@ -72,6 +154,23 @@ impl HostDriver {
         }
     }
 
+    /// The same host behind a [`UsbUart`] with latency timer `latency`:
+    /// its waits for the modem (T_ACK, T_IC) lengthened by it, as the
+    /// console does for a real adapter.
+    pub fn behind_usb(self, latency: Duration) -> HostDriver<UsbUart> {
+        let mut config = self.host.config();
+        config.timeouts.t_ack += latency;
+        config.timeouts.t_ic += latency;
+        config.timeouts.t_poll += latency;
+        HostDriver {
+            sim: UsbUart::new(self.sim, latency),
+            host: HostEngine::new(Dialect::St7580, config),
+            events: self.events,
+        }
+    }
+}
+
+impl<P: Io<Error = Infallible>> HostDriver<P> {
     /// Virtual time now.
     pub fn now(&self) -> Instant {
         self.sim.now()
@@ -98,6 +197,7 @@ impl HostDriver {
             if self.sim.now() >= end {
                 return false;
             }
+
             let events = &mut self.events;
             let Ok(now) = turn(&mut self.host, &mut self.sim, end, |host, at| {
                 events.extend(std::iter::from_fn(|| host.poll_event()).map(|e| (at, e)))

@@ -46,7 +46,7 @@ pub mod st7570;
 pub mod street;
 pub mod uart;
 
-pub use drive::{HostDriver, Outcome};
+pub use drive::{HostDriver, Outcome, UsbUart};
 pub use line::LineConfig;
 pub use ports::Ports;
 pub use profile::StreetProfile;
