@@ -22,15 +22,6 @@ use crate::util::{root, Result};
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::path::Path;
 
-/// Edges of circles that exist today and are being broken: each one
-/// edge (crate, from, to) that closes a circle, left out of the graph.
-/// Remove an entry once its edge is gone (the check says when); nothing
-/// is added here.
-const ALLOWED: &[(&str, &str, &str)] = &[
-    // The lamp page takes the street page's formatters.
-    ("plm-console", "views::lamp", "views::street"),
-];
-
 /// Checks every crate of the workspace (`crates/*` and `xtask`).
 pub fn run() -> Result {
     let root = root();
@@ -46,7 +37,7 @@ pub fn run() -> Result {
     for dir in &dirs {
         let name = dir.file_name().unwrap_or_default().to_string_lossy();
         let files = read_tree(&dir.join("src"))?;
-        let (count, found) = check(&name, &files, ALLOWED);
+        let (count, found) = check(&name, &files);
         modules += count;
         failures.extend(found);
     }
@@ -63,28 +54,16 @@ pub fn run() -> Result {
     }
 }
 
-/// Checks the crate `name` whose `src/` holds `files`, leaving out the
-/// edges `allowed` names for it: its number of modules, and its failures
-/// (each circle, each allowed edge that is gone) in words.
-fn check(
-    name: &str,
-    files: &BTreeMap<String, String>,
-    allowed: &[(&str, &str, &str)],
-) -> (usize, Vec<String>) {
+/// Checks the crate `name` whose `src/` holds `files`: its number of
+/// modules, and each circle in words.
+fn check(name: &str, files: &BTreeMap<String, String>) -> (usize, Vec<String>) {
     let mut graph = Graph::build(files);
-    let mut failures = Vec::new();
-    for &(_, from, to) in allowed.iter().filter(|(k, ..)| *k == name) {
-        if graph.remove(from, to) {
-            println!("circles: {name}: allowed for now: {from} -> {to}");
-        } else {
-            failures.push(format!(
-                "{name}: the allowed edge {from} -> {to} is gone: \
-                 remove it from ALLOWED in xtask/src/circles.rs"
-            ));
-        }
-    }
     graph.lift();
-    failures.extend(graph.circles().iter().map(|c| format!("{name}: {c}")));
+    let failures = graph
+        .circles()
+        .iter()
+        .map(|c| format!("{name}: {c}"))
+        .collect();
     (graph.names.len(), failures)
 }
 
@@ -240,15 +219,6 @@ impl Graph {
         }
         graph.modules = modules;
         graph
-    }
-
-    /// Drops the edge `from -> to` (by name); false when there is none.
-    fn remove(&mut self, from: &str, to: &str) -> bool {
-        let find = |name: &str| self.names.iter().position(|n| n == name);
-        match (find(from), find(to)) {
-            (Some(from), Some(to)) => self.edges[from].remove(&to),
-            _ => false,
-        }
     }
 
     /// Makes each module answer for its children: a child's edge to a
@@ -864,23 +834,11 @@ mod tests {
         .iter()
         .map(|(p, t)| (p.to_string(), t.to_string()))
         .collect();
-        let (modules, failures) = check("core", &files, &[]);
+        let (modules, failures) = check("core", &files);
         assert_eq!(modules, 4);
         assert_eq!(
             failures,
             ["core: decode (by decode::st7580) -> decode_app -> decode"]
-        );
-        // An allowed edge is left out; one that is gone is a failure.
-        let allowed = [
-            ("core", "decode/st7580", "decode_app"),
-            ("core", "decode::st7580", "decode_app"),
-            ("other", "decode_app", "decode"),
-        ];
-        let (_, failures) = check("core", &files, &allowed);
-        assert_eq!(failures.len(), 1, "{failures:?}");
-        assert!(
-            failures[0].contains("decode/st7580 -> decode_app is gone"),
-            "{failures:?}"
         );
     }
 

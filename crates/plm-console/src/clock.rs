@@ -7,3 +7,13 @@ pub fn page_now_us() -> f64 {
         .and_then(|w| w.performance())
         .map_or(0.0, |p| p.now() * 1_000.0)
 }
+
+/// The computer's clock, local time.
+pub fn computer_clock() -> plm_core::app::Clock {
+    let d = js_sys::Date::new_0();
+    plm_core::app::Clock {
+        hours: d.get_hours() as u8,
+        minutes: d.get_minutes() as u8,
+        seconds: d.get_seconds() as u8,
+    }
+}

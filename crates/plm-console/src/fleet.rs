@@ -287,9 +287,57 @@ pub fn street_energy<'a>(lamps: impl Iterator<Item = &'a Lamp>) -> String {
     )
 }
 
+/// A dimming value typed in a form: a number, whose range plm-core
+/// checks (`Hid::validate`) before anything is sent.
+pub fn dimming_value(text: &str) -> Result<u8, String> {
+    text.trim().parse::<u8>().map_err(|_| {
+        format!(
+            "nothing sent: \"{}\" is not a dimming value (a whole number of %)",
+            text.trim()
+        )
+    })
+}
+
+/// A board address as the key of its row (6 bytes in a u64), and back.
+pub fn row_key(a: Address) -> u64 {
+    let mut k = [0; 8];
+    k[2..].copy_from_slice(&a.0);
+    u64::from_be_bytes(k)
+}
+
+pub fn key_address(key: u64) -> Address {
+    let mut a = [0; 6];
+    a.copy_from_slice(&key.to_be_bytes()[2..]);
+    Address(a)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn dimming_values_must_be_numbers() {
+        assert_eq!(dimming_value(" 40 "), Ok(40));
+        assert!(dimming_value("4o")
+            .unwrap_err()
+            .contains("not a dimming value"));
+    }
+
+    #[test]
+    fn a_row_key_gives_its_address_back() {
+        for a in [
+            Address([0; 6]),
+            Address([0x00, 0x80, 0xE1, 0x00, 0x00, 0x01]),
+            Address::BROADCAST,
+        ] {
+            assert_eq!(key_address(row_key(a)), a);
+        }
+        // Distinct addresses, distinct rows.
+        assert_ne!(
+            row_key(Address([0, 0, 0, 0, 0, 1])),
+            row_key(Address([1, 0, 0, 0, 0, 0]))
+        );
+    }
     use plm_core::app::Ballast;
 
     /// The history's clock at the street's 0: 2026-11-28 12:03:05 UTC.

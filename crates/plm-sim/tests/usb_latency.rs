@@ -16,9 +16,15 @@ fn reads_behind_a_16_ms_latency_timer_are_answered_and_acked_in_time() {
     let start = d.now();
     for _ in 0..20 {
         let out = d.request(&read, 2_000 * MS);
-        assert!(matches!(out, Outcome::Answer(Command::MibReadConfirm { .. })), "{out:?}");
+        assert!(
+            matches!(out, Outcome::Answer(Command::MibReadConfirm { .. })),
+            "{out:?}"
+        );
     }
-    let retries = d.events.iter().filter(|(_, e)| matches!(e, Event::Retry { .. }));
+    let retries = d
+        .events
+        .iter()
+        .filter(|(_, e)| matches!(e, Event::Retry { .. }));
     assert_eq!(retries.count(), 0, "no attempt repeated");
     // Each exchange waits for the timer twice (the status message, the
     // confirm): far slower than the wire, as on a real adapter.

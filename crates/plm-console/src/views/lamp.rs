@@ -4,8 +4,9 @@
 
 use super::fixed;
 use super::plot::{self, Axis, Frame, Spec};
-use super::street::{computer_clock, dimming_value, key_address};
 use super::widgets::{button, escape, html, on_event, signal, text_input};
+use crate::clock::computer_clock;
+use crate::fleet::{dimming_value, key_address};
 use crate::stores::use_console;
 use crate::street::{Lamp, Sample};
 use crate::transport::LampAction;

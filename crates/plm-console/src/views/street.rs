@@ -11,10 +11,11 @@ use super::widgets::{
     button, checkbox, closest, draw_rows, live_button, on_click, on_event, scrolled, signal,
     text_input,
 };
-use crate::fleet::{self, Row, COLUMNS};
+use crate::clock::computer_clock;
+use crate::fleet::{self, dimming_value, key_address, row_key, Row, COLUMNS};
 use crate::stores::use_console;
 use leptos::prelude::*;
-use plm_core::app::service::{Clock, Service};
+use plm_core::app::service::Service;
 use plm_core::app::{Address, Message, Request};
 
 /// The view.
@@ -228,27 +229,6 @@ fn SweepControl() -> impl IntoView {
     }
 }
 
-/// A dimming value typed in a form: a number, whose range plm-core
-/// checks (`Hid::validate`) before anything is sent.
-pub(super) fn dimming_value(text: &str) -> Result<u8, String> {
-    text.trim().parse::<u8>().map_err(|_| {
-        format!(
-            "nothing sent: \"{}\" is not a dimming value (a whole number of %)",
-            text.trim()
-        )
-    })
-}
-
-/// The computer's clock, local time.
-pub(super) fn computer_clock() -> Clock {
-    let d = js_sys::Date::new_0();
-    Clock {
-        hours: d.get_hours() as u8,
-        minutes: d.get_minutes() as u8,
-        seconds: d.get_seconds() as u8,
-    }
-}
-
 #[component]
 fn GroupActions(
     selected: RwSignal<Vec<Address>>,
@@ -383,46 +363,4 @@ fn row_html(row: &Row, picked: bool, focus: bool) -> String {
 fn row_address(ev: &web_sys::Event) -> Option<Address> {
     let hex = closest(ev, "tr[data-address]")?.get_attribute("data-address")?;
     u64::from_str_radix(&hex, 16).ok().map(key_address)
-}
-
-/// A board address as the key of its row (6 bytes in a u64), and back.
-pub(super) fn row_key(a: Address) -> u64 {
-    let mut k = [0; 8];
-    k[2..].copy_from_slice(&a.0);
-    u64::from_be_bytes(k)
-}
-
-pub(super) fn key_address(key: u64) -> Address {
-    let mut a = [0; 6];
-    a.copy_from_slice(&key.to_be_bytes()[2..]);
-    Address(a)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn dimming_values_must_be_numbers() {
-        assert_eq!(dimming_value(" 40 "), Ok(40));
-        assert!(dimming_value("4o")
-            .unwrap_err()
-            .contains("not a dimming value"));
-    }
-
-    #[test]
-    fn a_row_key_gives_its_address_back() {
-        for a in [
-            Address([0; 6]),
-            Address([0x00, 0x80, 0xE1, 0x00, 0x00, 0x01]),
-            Address::BROADCAST,
-        ] {
-            assert_eq!(key_address(row_key(a)), a);
-        }
-        // Distinct addresses, distinct rows.
-        assert_ne!(
-            row_key(Address([0, 0, 0, 0, 0, 1])),
-            row_key(Address([1, 0, 0, 0, 0, 0]))
-        );
-    }
 }

@@ -5,8 +5,8 @@
 //! click listener opens the page of the lamp clicked, by its
 //! `data-address`.
 
-use super::{key_address, row_key};
 use crate::fleet::picture::{Cell, Grid, Picture, WIDTH};
+use crate::fleet::{key_address, row_key};
 use crate::stores::use_console;
 use crate::views::files;
 use crate::views::widgets::{button, closest, note, on_click, on_event, signal};
