@@ -4,9 +4,13 @@
 
 mod harness;
 
+use harness::chip::{
+    dl_indication as indication, ping, ping_confirm as confirm, ping_responder, DL_DATA_IND,
+    PING_CNF, PING_REQ,
+};
 use harness::{
-    check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, ping_responder, Dir,
-    Fault, Part, Sim, PING_CNF, PING_REQ,
+    check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, Dir, Fault, Part,
+    Sim,
 };
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Transmit, BUSY_LIMIT};
@@ -21,26 +25,10 @@ const BAUD: u32 = 57_600;
 const T_IC: u64 = 10 * MS;
 const T_ACK: u64 = 40 * MS;
 const T_SR: u64 = 200 * MS;
-/// DL_DataIndication, an unsolicited modem frame.
-const DL_DATA_IND: u8 = 0x52;
 
 /// One byte time at `baud`.
 fn b(baud: u32) -> u64 {
     wire_time(1, baud)
-}
-
-fn ping() -> LocalFrame {
-    LocalFrame::new(PING_REQ, vec![0x11, 0x22, 0x33])
-}
-
-fn confirm(req: &LocalFrame) -> LocalFrame {
-    LocalFrame::new(PING_CNF, req.data.clone())
-}
-
-/// A frame whose bytes hold no 02h/03h/06h/15h after the STX, so that
-/// what a receiver makes of its pieces is easy to predict.
-fn indication() -> LocalFrame {
-    LocalFrame::new(DL_DATA_IND, vec![0x10, 0x20, 0x30, 0x40])
 }
 
 fn emit(f: &LocalFrame) -> Vec<u8> {
@@ -61,170 +49,11 @@ fn first_wire(sim: &Sim, dir: Dir, part: Part) -> harness::WireByte {
         .expect("no such byte on the wire")
 }
 
-// ---- 1. happy path ------------------------------------------------------
-
-fn happy_path(baud: u32) {
-    let b1 = b(baud);
-    let mut sim = Sim::with_baud(baud).responder(ping_responder());
-    let req = ping();
-    let bytes = emit(&req);
-    let reply = confirm(&req);
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    // UM0932 3.2.8: T_REQ low, status, STX, T_REQ high once STX is out,
-    // the rest of the frame; then the host ACKs the modem's confirm.
-    let tx: Vec<Transmit> = sim.host_tx.iter().map(|(_, t)| t.clone()).collect();
-    assert_eq!(
-        tx,
-        vec![
-            Transmit::TReq { asserted: true },
-            Transmit::Bytes(vec![0x02]),
-            Transmit::TReq { asserted: false },
-            Transmit::Bytes(bytes[1..].to_vec()),
-            Transmit::Bytes(vec![ACK]),
-        ]
-    );
-
-    // What each side received.
-    let mut d2h = vec![0x3F, 0x00, ACK];
-    d2h.extend(emit(&reply));
-    assert_eq!(sim.received(Dir::DevToHost), d2h);
-    let mut h2d = bytes.clone();
-    h2d.push(ACK);
-    assert_eq!(sim.received(Dir::HostToDev), h2d);
-
-    // Timing. The status goes out as soon as T_REQ falls (the modem is
-    // idle), the STX as soon as the status is in, the ACK at once.
-    let status_end = wire_time(2, baud);
-    let status: Vec<_> = sim.wire(Dir::DevToHost).take(2).copied().collect();
-    assert_eq!(status[0].part, Part::Status { n: 0, offset: 0 });
-    assert_eq!((status[0].start, status[1].at), (0, status_end));
-    let stx = sim.frame_bytes(Dir::HostToDev, 0)[0];
-    assert_eq!((stx.sent, stx.start), (0x02, status_end));
-    // The device sees T_REQ released right when the STX is through.
-    assert_eq!(sim.treq, vec![(0, true), (stx.at, false)]);
-    let frame_end = sim.frame_end(Dir::HostToDev, 0);
-    assert_eq!(frame_end, status_end + wire_time(bytes.len(), baud));
-    let ack = first_wire(&sim, Dir::DevToHost, Part::Ack);
-    assert_eq!(ack.start, frame_end);
-    assert_eq!(
-        sim.host_events_where(is_delivered),
-        vec![(frame_end + b1, Event::Delivered(ticket))]
-    );
-
-    // The confirm: reported once, when its last byte is in, and ACKed.
-    let reply_end = sim.frame_end(Dir::DevToHost, 0);
-    assert_eq!(
-        sim.host_events_where(|e| matches!(e, Event::Frame(_))),
-        vec![(reply_end, Event::Frame(reply.clone()))]
-    );
-    let host_ack = first_wire(&sim, Dir::HostToDev, Part::Ack);
-    assert_eq!(host_ack.start, reply_end);
-    assert!(sim
-        .host_events_where(|e| is_retry(e) || is_failed(e) || is_repeat(e))
-        .is_empty());
-
-    // The device: one request, its confirm delivered without a repeat.
-    assert_eq!(sim.requests(), vec![req]);
-    assert_eq!(
-        sim.dev_events_where(|e| matches!(e, DeviceEvent::Delivered { .. })),
-        vec![(
-            reply_end + b1,
-            DeviceEvent::Delivered {
-                frame: reply,
-                repeated: false
-            }
-        )]
-    );
-    assert_eq!(sim.frame_bytes(Dir::DevToHost, 1), vec![], "no repeat");
-    assert!(sim.host.last_status().is_some());
-    assert_eq!(sim.host.pending(), 0);
-    assert!(sim.dev.is_idle());
-}
-
-#[test]
-fn happy_path_57600() {
-    happy_path(57_600);
-}
-
-#[test]
-fn happy_path_9600() {
-    happy_path(9_600);
-}
+// ---- 1. happy path: link_both.rs --------------------------------------------
 
 // ---- 2. NAK -------------------------------------------------------------
 
-#[test]
-fn nak_restarts_the_whole_sequence_and_the_modem_executes_once() {
-    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
-    // A data byte of the host's first frame is damaged on the line.
-    sim.inject(Dir::HostToDev, Some(1), Fault::Corrupt(0xFF), |c| {
-        c.part.is_frame_byte(0, 3)
-    });
-    let req = ping();
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    let received = sim.dev_received();
-    assert!(
-        matches!(
-            &received[0].1,
-            Element::Frame {
-                checksum_ok: false,
-                ..
-            }
-        ),
-        "{received:?}"
-    );
-    let nak = first_wire(&sim, Dir::DevToHost, Part::Nak);
-    assert_eq!(nak.start, sim.frame_end(Dir::HostToDev, 0), "NAK at once");
-
-    assert_eq!(
-        sim.host_events_where(is_retry),
-        vec![(
-            nak.at,
-            Event::Retry {
-                ticket,
-                attempt: 1,
-                cause: LinkError::Nak
-            }
-        )]
-    );
-    // 3.2.8 "a complete sequence must be restarted": T_REQ falls again
-    // (after T_IC high, a fresh edge), a new status, the frame again.
-    let stx0 = sim.frame_bytes(Dir::HostToDev, 0)[0];
-    let stx1 = sim.frame_bytes(Dir::HostToDev, 1)[0];
-    assert_eq!(
-        sim.treq,
-        vec![
-            (0, true),
-            (stx0.at, false),
-            (nak.at + T_IC, true),
-            (stx1.at, false)
-        ]
-    );
-    assert_eq!(statuses_sent(&sim), vec![0, nak.at + T_IC]);
-    let again: Vec<u8> = sim
-        .frame_bytes(Dir::HostToDev, 1)
-        .iter()
-        .map(|w| w.got.unwrap())
-        .collect();
-    assert_eq!(again, emit(&req));
-
-    let end1 = sim.frame_end(Dir::HostToDev, 1);
-    assert_eq!(
-        sim.host_events_where(is_delivered),
-        vec![(end1 + b(BAUD), Event::Delivered(ticket))]
-    );
-    assert!(sim.host_events_where(is_failed).is_empty());
-    assert_eq!(
-        sim.requests(),
-        vec![req.clone()],
-        "exactly one accepted request"
-    );
-    assert_eq!(sim.host_frames(), vec![confirm(&req)]);
-}
+// (The NAK that restarts the sequence: link_both.rs.)
 
 // ---- 3. lost ACK ----------------------------------------------------------
 
@@ -714,62 +543,7 @@ fn the_ack_of_a_repeat_does_not_acknowledge_the_next_frame() {
     );
 }
 
-// ---- 7. a modem frame while the host waits for the status -------------------
-
-#[test]
-fn modem_frame_while_host_waits_for_status() {
-    let b1 = b(BAUD);
-    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
-    let ind = indication();
-    sim.dev_submit(ind.clone());
-    // Three bytes into the modem's frame, the host wants to send.
-    sim.run_until(3 * b1);
-    let req = ping();
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    let ind_end = sim.frame_end(Dir::DevToHost, 0);
-    assert_eq!(sim.treq[0], (3 * b1, true));
-    assert!(3 * b1 < ind_end, "T_REQ fell while the modem was sending");
-    // The host ACKs the indication; only then does the modem, master of
-    // the line (3.2.5), answer T_REQ with the status.
-    let h2d: Vec<_> = sim.wire(Dir::HostToDev).copied().collect();
-    assert_eq!((h2d[0].part, h2d[0].start), (Part::Ack, ind_end));
-    let status = first_wire(&sim, Dir::DevToHost, Part::Status { n: 0, offset: 0 });
-    assert_eq!(status.start, ind_end + b1);
-    let stx = sim.frame_bytes(Dir::HostToDev, 0)[0];
-    assert_eq!(stx.start, status.start + wire_time(2, BAUD));
-
-    // Host events in order: the indication, the status, its own delivery,
-    // the confirm.
-    let order: Vec<Event> = sim
-        .host_events
-        .iter()
-        .map(|(_, e)| e.clone())
-        .filter(|e| {
-            matches!(
-                e,
-                Event::Frame(_) | Event::Delivered(_) | Event::Received(Element::Status(_))
-            )
-        })
-        .collect();
-    assert_eq!(order.len(), 4, "{order:?}");
-    assert_eq!(order[0], Event::Frame(ind.clone()));
-    assert!(matches!(order[1], Event::Received(Element::Status(_))));
-    assert_eq!(order[2], Event::Delivered(ticket));
-    assert_eq!(order[3], Event::Frame(confirm(&req)));
-    assert!(sim
-        .host_events_where(|e| is_retry(e) || is_failed(e) || is_repeat(e))
-        .is_empty());
-    assert_eq!(sim.requests(), vec![req]);
-    assert_eq!(
-        sim.dev_events_where(|e| matches!(e, DeviceEvent::Delivered { .. }))[0].1,
-        DeviceEvent::Delivered {
-            frame: ind,
-            repeated: false
-        }
-    );
-}
+// ---- 7. a modem frame while the host waits for the status: link_both.rs ----
 
 // ---- 8. MIB 09h timeouts ----------------------------------------------------
 

@@ -7,12 +7,16 @@
 
 mod harness;
 
+use harness::chip::{
+    data_indication as indication, read_db, read_db_confirm as confirm, read_db_responder,
+    READ_DB_CNF, READ_DB_REQ,
+};
 use harness::{
     check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, Dir, Fault, Part,
-    Responder, Sim,
+    Sim,
 };
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
-use plm_core::link::host::{Event, HostConfig, LinkError, Transmit};
+use plm_core::link::host::{Event, HostConfig, LinkError};
 use plm_core::link::{
     Dialect, Element, GarbageReason, LocalFrame, StatusMessage, TicSelector, Timeouts, ACK, NAK,
 };
@@ -28,11 +32,6 @@ const T_WBC: u64 = 5 * MS;
 /// MIB 000Bh factory default (b7 = 0): 5 characters, 869 µs at 57 600.
 const T_IC: u64 = 869;
 
-/// CMD_ReadDBRequest, CMD_ReadDBConfirm (UM Table 15).
-const READ_DB_REQ: u8 = 0x90;
-const READ_DB_CNF: u8 = 0x91;
-/// CMD_DataIndication, an unsolicited modem frame.
-const DATA_IND: u8 = 0x50;
 /// CMD_IS_Indication: the same byte as NAK.
 const IS_IND: u8 = 0x15;
 
@@ -62,28 +61,6 @@ fn sim_with(t: Timeouts) -> Sim {
     .responder(read_db_responder());
     sim.dev.set_timeouts(t);
     sim
-}
-
-/// The modem application: CMD_ReadDBConfirm with the index asked and one
-/// value byte.
-fn read_db_responder() -> Responder {
-    Box::new(|_, f| (f.code == READ_DB_REQ).then(|| confirm(f)))
-}
-
-/// CMD_ReadDBRequest of MIB 000Bh; no 02h/06h/15h/3Fh after its STX.
-fn read_db() -> LocalFrame {
-    LocalFrame::new(READ_DB_REQ, vec![0x0B, 0x00])
-}
-
-fn confirm(req: &LocalFrame) -> LocalFrame {
-    let mut data = req.data.clone();
-    data.push(0x80);
-    LocalFrame::new(READ_DB_CNF, data)
-}
-
-/// A data indication with no 02h/06h/15h/3Fh after its STX.
-fn indication(n: u8) -> LocalFrame {
-    LocalFrame::new(DATA_IND, vec![0x40 + n, 0x41, 0x42, 0x43])
 }
 
 fn emit(f: &LocalFrame) -> Vec<u8> {
@@ -119,92 +96,11 @@ fn frames_sent(sim: &Sim, dir: Dir) -> usize {
         .count()
 }
 
-// ---- 1. the sequence of 5.2.2 ------------------------------------------------
-
-fn happy_path(baud: u32) {
-    let b1 = wire_time(1, baud);
-    let mut sim = sim_at(baud);
-    let req = read_db();
-    let bytes = emit(&req);
-    assert_eq!(bytes, [0x02, 0x05, 0x90, 0x0B, 0x00, 0xA0, 0x00]);
-    let reply = confirm(&req);
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    // UM 5.2.2: T_REQ low, status, STX, T_REQ high once STX is out, the
-    // rest; then the host ACKs the modem's confirm.
-    let tx: Vec<Transmit> = sim.host_tx.iter().map(|(_, t)| t.clone()).collect();
-    assert_eq!(
-        tx,
-        vec![
-            Transmit::TReq { asserted: true },
-            Transmit::Bytes(vec![0x02]),
-            Transmit::TReq { asserted: false },
-            Transmit::Bytes(bytes[1..].to_vec()),
-            Transmit::Bytes(vec![ACK]),
-        ]
-    );
-    // A 4-byte status message (Table 11), then ACK, then the confirm.
-    let mut d2h = vec![0x3F, 0x00, 0x00, 0x00, ACK];
-    d2h.extend(emit(&reply));
-    assert_eq!(sim.received(Dir::DevToHost), d2h);
-    let mut h2d = bytes.clone();
-    h2d.push(ACK);
-    assert_eq!(sim.received(Dir::HostToDev), h2d);
-
-    // The status starts at once (well within T_POLL), the STX as soon as
-    // the status is in, T_REQ is high once the STX is through.
-    let status_end = wire_time(4, baud);
-    let status = first_wire(&sim, Dir::DevToHost, Part::Status { n: 0, offset: 0 });
-    assert_eq!(status.start, 0);
-    let stx = sim.frame_bytes(Dir::HostToDev, 0)[0];
-    assert_eq!((stx.sent, stx.start), (0x02, status_end));
-    assert_eq!(sim.treq, vec![(0, true), (stx.at, false)]);
-    let frame_end = sim.frame_end(Dir::HostToDev, 0);
-    let ack = first_wire(&sim, Dir::DevToHost, Part::Ack);
-    assert_eq!(ack.start, frame_end);
-    assert_eq!(
-        sim.host_events_where(is_delivered),
-        vec![(frame_end + b1, Event::Delivered(ticket))]
-    );
-    assert_eq!(
-        sim.host.last_status(),
-        Some(StatusMessage::new(ST7570, &[0, 0, 0]))
-    );
-
-    // The confirm, reported once and ACKed at once; delivered on the ACK.
-    let reply_end = sim.frame_end(Dir::DevToHost, 0);
-    assert_eq!(
-        sim.host_events_where(|e| matches!(e, Event::Frame(_))),
-        vec![(reply_end, Event::Frame(reply.clone()))]
-    );
-    assert_eq!(first_wire(&sim, Dir::HostToDev, Part::Ack).start, reply_end);
-    assert_eq!(
-        delivered_by_dev(&sim),
-        vec![(
-            reply_end + b1,
-            DeviceEvent::Delivered {
-                frame: reply,
-                repeated: false
-            }
-        )]
-    );
-    assert!(sim
-        .host_events_where(|e| is_retry(e) || is_failed(e) || is_repeat(e))
-        .is_empty());
-    assert_eq!(sim.requests(), vec![req]);
-    assert_eq!(sim.host.pending(), 0);
-    assert!(sim.dev.is_idle());
-}
+// ---- 1. the sequence of 5.2.2: link_both.rs; the request's bytes ----------
 
 #[test]
-fn happy_path_57600() {
-    happy_path(57_600);
-}
-
-#[test]
-fn happy_path_9600() {
-    happy_path(9_600);
+fn the_read_db_request_is_these_bytes() {
+    assert_eq!(emit(&read_db()), [0x02, 0x05, 0x90, 0x0B, 0x00, 0xA0, 0x00]);
 }
 
 // ---- 2. T_POLL ---------------------------------------------------------------
@@ -505,41 +401,7 @@ fn a_gap_in_a_modem_frame_is_naked_and_repeated_not_lost() {
 
 // ---- 5. T_ACK and NAK from the modem ----------------------------------------------
 
-#[test]
-fn nak_restarts_the_whole_sequence() {
-    let mut sim = sim();
-    sim.inject(Dir::HostToDev, Some(1), Fault::Corrupt(0xFF), |c| {
-        c.part.is_frame_byte(0, 3)
-    });
-    let req = read_db();
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    let nak = first_wire(&sim, Dir::DevToHost, Part::Nak);
-    assert_eq!(nak.start, sim.frame_end(Dir::HostToDev, 0), "NAK at once");
-    let stx1 = sim.frame_bytes(Dir::HostToDev, 1)[0];
-    // T_REQ high for T_IC, then the whole sequence: T_REQ, status, frame.
-    assert_eq!(sim.treq[2..], [(nak.at + T_IC, true), (stx1.at, false)]);
-    assert_eq!(statuses_sent(&sim), vec![0, nak.at + T_IC]);
-    assert_eq!(
-        sim.host_events_where(outcome),
-        vec![
-            (
-                nak.at,
-                Event::Retry {
-                    ticket,
-                    attempt: 1,
-                    cause: LinkError::Nak
-                }
-            ),
-            (
-                sim.frame_end(Dir::HostToDev, 1) + b(),
-                Event::Delivered(ticket)
-            )
-        ]
-    );
-    assert_eq!(sim.requests(), vec![req]);
-}
+// (The NAK that restarts the sequence: link_both.rs.)
 
 #[test]
 fn no_ack_within_t_ack_restarts_the_whole_sequence() {
@@ -813,51 +675,7 @@ fn the_same_answer_to_a_request_asked_again_is_a_new_frame() {
     }
 }
 
-// ---- 8. a modem frame while the host waits for the status ----------------------------
-
-#[test]
-fn modem_frame_while_host_waits_for_status() {
-    let b1 = b();
-    let mut sim = sim();
-    let ind = indication(0);
-    sim.dev_submit(ind.clone());
-    sim.run_until(3 * b1);
-    let req = read_db();
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    let ind_end = sim.frame_end(Dir::DevToHost, 0);
-    assert_eq!(sim.treq[0], (3 * b1, true));
-    // The host ACKs the indication; then the modem, master of the line,
-    // answers T_REQ with the status.
-    let h2d: Vec<_> = sim.wire(Dir::HostToDev).copied().collect();
-    assert_eq!((h2d[0].part, h2d[0].start), (Part::Ack, ind_end));
-    let status = first_wire(&sim, Dir::DevToHost, Part::Status { n: 0, offset: 0 });
-    assert_eq!(status.start, ind_end + b1);
-    assert_eq!(
-        sim.frame_start(Dir::HostToDev, 0),
-        status.start + wire_time(4, BAUD)
-    );
-    let order: Vec<Event> = sim
-        .host_events
-        .iter()
-        .map(|(_, e)| e.clone())
-        .filter(|e| {
-            matches!(
-                e,
-                Event::Frame(_) | Event::Delivered(_) | Event::Received(Element::Status(_))
-            )
-        })
-        .collect();
-    assert_eq!(order.len(), 4, "{order:?}");
-    assert_eq!(order[0], Event::Frame(ind));
-    assert!(matches!(order[1], Event::Received(Element::Status(_))));
-    assert_eq!(order[2], Event::Delivered(ticket));
-    assert_eq!(order[3], Event::Frame(confirm(&req)));
-    assert!(sim
-        .host_events_where(|e| is_retry(e) || is_failed(e))
-        .is_empty());
-}
+// ---- 8. a modem frame while the host waits for the status (the first: link_both.rs)
 
 #[test]
 fn a_nakked_modem_frame_and_its_repeat_while_host_waits_for_status() {

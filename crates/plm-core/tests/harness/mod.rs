@@ -28,6 +28,8 @@
 
 #![allow(dead_code)]
 
+pub mod chip;
+
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, HostEngine, Ticket, Transmit};
 use plm_core::link::{Dialect, Element, LocalFrame, ACK, NAK, STATUS_FIRST};
@@ -336,16 +338,6 @@ pub struct Sim {
     pub treq: Vec<(Instant, bool)>,
     /// Safety net: the loop stops (and panics) after this virtual time.
     pub horizon: Instant,
-}
-
-/// The ping the tests use (PingRequest, UM0932 Table 10).
-pub const PING_REQ: u8 = 0x2C;
-/// Its confirm (PingConfirm).
-pub const PING_CNF: u8 = 0x2D;
-
-/// The modem application for pings: PingConfirm with the request's data.
-pub fn ping_responder() -> Responder {
-    Box::new(|_, f| (f.code == PING_REQ).then(|| LocalFrame::new(PING_CNF, f.data.clone())))
 }
 
 impl Sim {
