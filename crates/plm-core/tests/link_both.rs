@@ -277,3 +277,57 @@ fn nak_restarts_the_whole_sequence_and_the_modem_executes_once() {
         assert_eq!(sim.host_frames(), vec![(chip.confirm)(&req)]);
     }
 }
+
+/// The modem's ACK of the host's frame is lost: the host waits T_ACK and
+/// restarts the whole sequence. Local frames carry no sequence number
+/// (UM0932 3.2, ST7570 UM Table 10): the modem cannot tell the restarted
+/// frame from a new request, so it runs the request twice and confirms
+/// twice, and the host, which ACKed the first confirm while it still
+/// waited for its own ACK, reports both. Layers above must match
+/// confirms to requests with this in mind.
+#[test]
+fn a_lost_ack_restarts_the_sequence_after_t_ack_and_the_modem_runs_the_request_twice() {
+    for chip in &BOTH {
+        let mut sim = chip.bench(BAUD);
+        let t = sim.host.config().timeouts;
+        sim.inject(Dir::DevToHost, Some(1), Fault::Drop, |c| {
+            c.part == Part::Ack
+        });
+        let req = (chip.request)();
+        let ticket = sim.submit(req.clone());
+        sim.run_to_idle();
+
+        let end0 = sim.frame_end(Dir::HostToDev, 0);
+        assert_eq!(
+            sim.host_events_where(is_retry),
+            vec![(
+                end0 + t.t_ack,
+                Event::Retry {
+                    ticket,
+                    attempt: 1,
+                    cause: LinkError::NoAck
+                }
+            )],
+            "{}",
+            chip.name
+        );
+        // The whole sequence again: T_REQ low after T_IC high, a new
+        // status, the same frame.
+        let stx1 = sim.frame_bytes(Dir::HostToDev, 1)[0];
+        assert_eq!(
+            sim.treq[2..],
+            [(end0 + t.t_ack + t.t_ic, true), (stx1.at, false)]
+        );
+        assert_eq!(statuses_sent(&sim), vec![0, end0 + t.t_ack + t.t_ic]);
+        let end1 = sim.frame_end(Dir::HostToDev, 1);
+        assert_eq!(
+            sim.host_events_where(is_delivered),
+            vec![(end1 + wire_time(1, BAUD), Event::Delivered(ticket))]
+        );
+        assert!(sim.host_events_where(is_failed).is_empty());
+        assert_eq!(sim.requests(), vec![req.clone(), req.clone()]);
+        let confirm = (chip.confirm)(&req);
+        assert_eq!(sim.host_frames(), vec![confirm.clone(), confirm]);
+        assert!(sim.host_events_where(is_repeat).is_empty());
+    }
+}

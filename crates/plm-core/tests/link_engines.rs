@@ -57,59 +57,7 @@ fn first_wire(sim: &Sim, dir: Dir, part: Part) -> harness::WireByte {
 
 // ---- 3. lost ACK ----------------------------------------------------------
 
-#[test]
-fn lost_ack_times_out_after_t_ack_and_restarts() {
-    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
-    sim.inject(Dir::DevToHost, Some(1), Fault::Drop, |c| {
-        c.part == Part::Ack
-    });
-    let req = ping();
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    let end0 = sim.frame_end(Dir::HostToDev, 0);
-    let retries = sim.host_events_where(is_retry);
-    assert_eq!(
-        retries,
-        vec![(
-            end0 + T_ACK,
-            Event::Retry {
-                ticket,
-                attempt: 1,
-                cause: LinkError::NoAck
-            }
-        )]
-    );
-    assert!(
-        retries[0].0 >= end0 + T_ACK,
-        "not before T_ACK after the frame"
-    );
-
-    // The whole sequence again: T_REQ low after T_IC high, a new status,
-    // the same frame.
-    let stx1 = sim.frame_bytes(Dir::HostToDev, 1)[0];
-    assert_eq!(
-        sim.treq[2..],
-        [(end0 + T_ACK + T_IC, true), (stx1.at, false)]
-    );
-    assert_eq!(statuses_sent(&sim), vec![0, end0 + T_ACK + T_IC]);
-    let end1 = sim.frame_end(Dir::HostToDev, 1);
-    assert_eq!(
-        sim.host_events_where(is_delivered),
-        vec![(end1 + b(BAUD), Event::Delivered(ticket))]
-    );
-    assert!(sim.host_events_where(is_failed).is_empty());
-
-    // UM0932 local frames carry no sequence number: the modem cannot tell
-    // the restarted frame from a new request. It accepted the first copy
-    // (only its ACK was lost), so it executes the ping twice and confirms
-    // twice, and the host, which ACKed the first confirm while it still
-    // waited for its own ACK, reports both. Layers above must match
-    // confirms to requests with this in mind.
-    assert_eq!(sim.requests(), vec![req.clone(), req.clone()]);
-    assert_eq!(sim.host_frames(), vec![confirm(&req), confirm(&req)]);
-    assert!(sim.host_events_where(is_repeat).is_empty());
-}
+// (A lost ACK restarting the sequence: link_both.rs.)
 
 // ---- 4. T_SR --------------------------------------------------------------
 

@@ -403,34 +403,7 @@ fn a_gap_in_a_modem_frame_is_naked_and_repeated_not_lost() {
 
 // (The NAK that restarts the sequence: link_both.rs.)
 
-#[test]
-fn no_ack_within_t_ack_restarts_the_whole_sequence() {
-    let mut sim = sim();
-    sim.inject(Dir::DevToHost, Some(1), Fault::Drop, |c| {
-        c.part == Part::Ack
-    });
-    let req = read_db();
-    let ticket = sim.submit(req.clone());
-    sim.run_to_idle();
-
-    let end0 = sim.frame_end(Dir::HostToDev, 0);
-    assert_eq!(
-        sim.host_events_where(is_retry),
-        vec![(
-            end0 + T_ACK,
-            Event::Retry {
-                ticket,
-                attempt: 1,
-                cause: LinkError::NoAck
-            }
-        )]
-    );
-    assert_eq!(statuses_sent(&sim)[1], end0 + T_ACK + T_IC);
-    assert_eq!(sim.host_events_where(is_delivered).len(), 1);
-    // No sequence numbers in UM Table 10: the modem had accepted the first
-    // copy and executes the request twice.
-    assert_eq!(sim.requests(), vec![req.clone(), req]);
-}
+// (A lost ACK restarting the sequence: link_both.rs.)
 
 #[test]
 fn t_ack_is_configurable() {
