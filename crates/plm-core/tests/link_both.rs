@@ -8,27 +8,15 @@
 mod harness;
 
 use harness::chip::{Chip, BOTH};
-use harness::{is_delivered, is_failed, is_repeat, is_retry, Dir, Fault, Part, Sim, WireByte};
+use harness::{
+    first_wire, is_delivered, is_failed, is_repeat, is_retry, statuses_sent, Dir, Fault, Part,
+};
 use plm_core::link::device::DeviceEvent;
 use plm_core::link::host::{Event, LinkError, Transmit};
 use plm_core::link::{Element, StatusMessage, ACK};
-use plm_core::time::{wire_time, Instant};
+use plm_core::time::wire_time;
 
 const BAUD: u32 = 57_600;
-
-fn first_wire(sim: &Sim, dir: Dir, part: Part) -> WireByte {
-    *sim.wire(dir)
-        .find(|w| w.part == part)
-        .expect("no such byte on the wire")
-}
-
-fn statuses_sent(sim: &Sim) -> Vec<Instant> {
-    sim.dev_sent()
-        .into_iter()
-        .filter(|(_, e)| matches!(e, Element::Status(_)))
-        .map(|(t, _)| t)
-        .collect()
-}
 
 /// One request and its answer, nothing going wrong.
 fn happy_path(chip: &Chip, baud: u32) {

@@ -9,8 +9,8 @@ use harness::chip::{
     PING_CNF, PING_REQ,
 };
 use harness::{
-    check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, Dir, Fault, Part,
-    Sim,
+    check_lossy, first_wire, is_delivered, is_failed, is_repeat, is_retry, lossy_requests,
+    statuses_sent, Dir, Fault, Part, Sim,
 };
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Transmit, BUSY_LIMIT};
@@ -33,20 +33,6 @@ fn b(baud: u32) -> u64 {
 
 fn emit(f: &LocalFrame) -> Vec<u8> {
     f.emit(Dialect::St7580).unwrap()
-}
-
-fn statuses_sent(sim: &Sim) -> Vec<Instant> {
-    sim.dev_sent()
-        .into_iter()
-        .filter(|(_, e)| matches!(e, Element::Status(_)))
-        .map(|(t, _)| t)
-        .collect()
-}
-
-fn first_wire(sim: &Sim, dir: Dir, part: Part) -> harness::WireByte {
-    *sim.wire(dir)
-        .find(|w| w.part == part)
-        .expect("no such byte on the wire")
 }
 
 // ---- 1. happy path: link_both.rs --------------------------------------------

@@ -12,8 +12,8 @@ use harness::chip::{
     READ_DB_CNF, READ_DB_REQ,
 };
 use harness::{
-    check_lossy, is_delivered, is_failed, is_repeat, is_retry, lossy_requests, Dir, Fault, Part,
-    Sim,
+    check_lossy, first_wire, is_delivered, is_failed, is_repeat, is_retry, lossy_requests,
+    statuses_sent, Dir, Fault, Part, Sim,
 };
 use plm_core::link::device::{DeviceEngine, DeviceEvent};
 use plm_core::link::host::{Event, HostConfig, LinkError};
@@ -73,20 +73,6 @@ fn outcome(e: &Event) -> bool {
 
 fn delivered_by_dev(sim: &Sim) -> Vec<(Instant, DeviceEvent)> {
     sim.dev_events_where(|e| matches!(e, DeviceEvent::Delivered { .. }))
-}
-
-fn statuses_sent(sim: &Sim) -> Vec<Instant> {
-    sim.dev_sent()
-        .into_iter()
-        .filter(|(_, e)| matches!(e, Element::Status(_)))
-        .map(|(t, _)| t)
-        .collect()
-}
-
-fn first_wire(sim: &Sim, dir: Dir, part: Part) -> harness::WireByte {
-    *sim.wire(dir)
-        .find(|w| w.part == part)
-        .expect("no such byte on the wire")
 }
 
 /// How many frames went `dir`.

@@ -689,6 +689,22 @@ pub fn faults(seed: u64, drop_pm: u64, corrupt_pm: u64) -> impl FnMut(&ByteCtx) 
 }
 
 /// The host's events by kind.
+/// When the device sent each status message.
+pub fn statuses_sent(sim: &Sim) -> Vec<Instant> {
+    sim.dev_sent()
+        .into_iter()
+        .filter(|(_, e)| matches!(e, Element::Status(_)))
+        .map(|(t, _)| t)
+        .collect()
+}
+
+/// The first byte of `part` that went `dir`.
+pub fn first_wire(sim: &Sim, dir: Dir, part: Part) -> WireByte {
+    *sim.wire(dir)
+        .find(|w| w.part == part)
+        .expect("no such byte on the wire")
+}
+
 pub fn is_retry(e: &Event) -> bool {
     matches!(e, Event::Retry { .. })
 }
