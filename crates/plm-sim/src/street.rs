@@ -126,7 +126,7 @@ impl StreetDriver {
     /// Sends a request and waits for its fate (answer, failure, or sent).
     pub fn request(&mut self, request: Request, limit: Duration) -> Option<AppEvent> {
         let log = &mut self.log;
-        let Ok(fate) = job::fate(&mut self.conc, &mut self.sim, request, limit, |at, h| {
+        let Ok((_, fate)) = job::fate(&mut self.conc, &mut self.sim, request, limit, |at, h| {
             log.push((at, h.clone()))
         });
         fate

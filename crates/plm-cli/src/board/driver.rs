@@ -144,9 +144,9 @@ impl Driver {
     pub fn request(&mut self, request: Request) -> Result<AppEvent, Failure> {
         let address = request.address;
         let guard = REQUEST_GUARD.as_micros() as Instant;
-        let fate = job::fate(&mut self.conc, &mut self.wall, request, guard, |_, _| {})?;
+        let (id, fate) = job::fate(&mut self.conc, &mut self.wall, request, guard, |_, _| {})?;
         Ok(fate.unwrap_or_else(|| AppEvent::Failed {
-            id: RequestId(u32::MAX),
+            id,
             address,
             reason: format!(
                 "no answer within {} s (the requester never gave up: a bug)",

@@ -312,14 +312,15 @@ pub fn drive<J: Job, I: Io + ?Sized>(
 
 /// Submits `request` and runs until its fate (answered, failed, or sent
 /// when it expects no answer) or until `limit` has passed: one request of
-/// a driver that waits for it. `each` sees every happening on the way.
+/// a driver that waits for it. Returns the request's id and its fate
+/// (`None`: none by the limit). `each` sees every happening on the way.
 pub fn fate<I: Io + ?Sized>(
     conc: &mut Concentrator,
     io: &mut I,
     request: Request,
     limit: crate::time::Duration,
     mut each: impl FnMut(Instant, &Happening),
-) -> Result<Option<AppEvent>, I::Error> {
+) -> Result<(RequestId, Option<AppEvent>), I::Error> {
     let id = conc.submit(io.now(), request);
     let until = io.now() + limit;
     // A turn first, even when the fate is known at once (a broadcast is
@@ -333,10 +334,10 @@ pub fn fate<I: Io + ?Sized>(
             each(now, &h);
             if let Happening::App(e) = h {
                 if e.fate_of() == Some(id) {
-                    return Ok(Some(e));
+                    return Ok((id, Some(e)));
                 }
             }
         }
     }
-    Ok(None)
+    Ok((id, None))
 }
