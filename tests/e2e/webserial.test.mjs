@@ -116,29 +116,45 @@ async function bridge(context, sim) {
     const client = await Rfc2217Client.connect({ host: sim.host, port: sim.port, baud: settings.baudRate });
     // Bytes reach the page as a USB-UART adapter delivers them: in
     // packets, sent when the line has been quiet for its latency timer
-    // (2 ms here, FTDI's low-latency setting) or 62 bytes are waiting, one
-    // packet after the other. (`plm sim` writes each byte at its wire time;
-    // a page call per byte would take longer than T_IC between bytes.)
+    // (2 ms here, FTDI's low-latency setting) or 62 bytes are waiting.
+    // (`plm sim` writes each byte at its wire time; a page call per byte
+    // would take longer than T_IC between bytes.) One page call at a time
+    // carries every packet that is ready, as the USB host takes every
+    // packet the adapter holds at each poll: on a busy machine a page call
+    // takes tens of ms, and calls queued one per packet held a frame's
+    // tail back past the host's T_IC (a confirm lost as a cut frame).
+    let ready = [];
     let pending = [];
     let timer = null;
-    let sent = Promise.resolve();
+    let busy = false;
+    const deliver = async () => {
+      if (busy) return;
+      busy = true;
+      while (ready.length > 0) {
+        const packets = ready;
+        ready = [];
+        try {
+          await page?.evaluate(([i, ps]) => ps.forEach((b) => window.__plmSerialShim.receive(i, b)), [id, packets]);
+        } catch {
+          // The page went away: the bytes are lost, as on a pulled cable.
+        }
+      }
+      busy = false;
+    };
     const flush = () => {
       clearTimeout(timer);
       timer = null;
-      const packet = pending;
+      if (pending.length > 0) ready.push(pending);
       pending = [];
-      if (packet.length === 0) return;
-      sent = sent
-        .then(() => page?.evaluate(([i, b]) => window.__plmSerialShim.receive(i, b), [id, packet]))
-        .catch(() => {});
+      deliver();
     };
     client.on('data', (bytes) => {
-      pending.push(...bytes);
-      if (pending.length >= 62) flush();
-      else {
-        clearTimeout(timer);
-        timer = setTimeout(flush, 2);
+      for (const b of bytes) {
+        pending.push(b);
+        if (pending.length === 62) flush();
       }
+      clearTimeout(timer);
+      timer = pending.length > 0 ? setTimeout(flush, 2) : null;
     });
     wire.clients.push(client);
     wire.current = client;
