@@ -2,10 +2,27 @@
 //! transport stamp and pace by.
 
 /// The page's clock in µs (`performance.now()`; 0 where there is none).
+/// Natively (the tests) it stands where [`set_page_now_us`] put it.
 pub fn page_now_us() -> f64 {
-    web_sys::window()
-        .and_then(|w| w.performance())
-        .map_or(0.0, |p| p.now() * 1_000.0)
+    #[cfg(target_arch = "wasm32")]
+    {
+        web_sys::window()
+            .and_then(|w| w.performance())
+            .map_or(0.0, |p| p.now() * 1_000.0)
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    NATIVE_NOW.get()
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+thread_local! {
+    static NATIVE_NOW: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) };
+}
+
+/// Natively: moves the page's clock to `us`.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn set_page_now_us(us: f64) {
+    NATIVE_NOW.set(us);
 }
 
 /// The computer's clock, local time.
