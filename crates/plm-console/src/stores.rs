@@ -30,7 +30,6 @@ use crate::session::{Note, Outcome, Session, Tick};
 use crate::storage::load;
 use crate::street::{Alert, Lamp, StreetSession, StreetTick, Sweep};
 use crate::street_store;
-use crate::throttle::Throttle;
 use crate::traffic::TrafficLog;
 use crate::transport::sim::SimTransport;
 use crate::transport::Transport;
@@ -59,11 +58,6 @@ pub const LINE_EVENTS: usize = 200;
 /// The longest the page sleeps with nothing due, µs: within the session's
 /// catch-up limit, so that a simulated world keeps the page's time.
 pub const IDLE_WAKE_US: f64 = 50_000.0;
-
-/// The Street and Firmware update views are drawn again at most five
-/// times a second; a change waits at most this and one tick
-/// ([`IDLE_WAKE_US`]).
-pub const STREET_DRAW_US: f64 = 200_000.0;
 
 /// How long a hardware reset holds RESETN low (DTR asserted). UM0932
 /// gives no minimum; 20 ms is far beyond any reset filter.

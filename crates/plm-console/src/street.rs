@@ -11,6 +11,7 @@ mod campaign;
 pub use campaign::Campaign;
 
 use crate::driver::{self, earliest, AnyEngine, Budget, Driver, Layer};
+use crate::throttle::Throttle;
 use crate::transport::{LinkState, Transport};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::energy::Meter;
@@ -31,6 +32,14 @@ use std::collections::{BTreeMap, VecDeque};
 pub const HISTORY: usize = 240;
 /// Pause between two sweeps of the street.
 pub const SWEEP_PAUSE: Duration = 5_000 * MS;
+/// The Street and Firmware update views are drawn again at most five
+/// times a second; a change waits at most this and one tick
+/// (`stores::IDLE_WAKE_US`).
+pub const STREET_DRAW_US: f64 = 200_000.0;
+/// Through a bare modem, while the discovery or the sweep has the line,
+/// the views are drawn at its quiet moments ([`StreetSession::send_next`]);
+/// without one, after this at the latest.
+pub const STREET_DRAW_LATE_US: f64 = 1_000_000.0;
 
 /// One reading of a lamp, for its history.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -130,13 +139,17 @@ pub struct StreetTick {
     /// Frames on the wire (USART elements, or the modem's link), as
     /// `plm decode` names them, with their times.
     pub traffic: Vec<(Instant, Decoded)>,
-    /// Frames the console sent towards the street.
+    /// Frames the console sent towards the street (in [`StreetSession::hand_out`]'s
+    /// ticks: since the views were last drawn).
     pub sent: u64,
     /// The update campaign changed (to save it, and to show it).
     pub campaign: bool,
     /// The street found changed: a lamp heard, a new session, a new
     /// release (to remember it, [`StreetSession::remembered`]).
     pub found: bool,
+    /// The street's views are to be drawn now (at most every
+    /// [`STREET_DRAW_US`]).
+    pub show: bool,
 }
 
 /// The street session.
@@ -157,14 +170,22 @@ pub struct StreetSession {
     round: Option<Round>,
     next_sweep: Option<Instant>,
     fleet: BTreeMap<Address, Lamp>,
-    /// Requests that wait for the round's slots to close.
-    held: Vec<(Request, Purpose)>,
+    /// Requests that wait for the round's slots to close, or for the
+    /// page to draw the street's views ([`StreetSession::send_next`]);
+    /// a broadcast of the discovery or the sweep has no purpose.
+    held: Vec<(Request, Option<Purpose>)>,
     /// What each request under way is for (a few at a time: a list).
     purposes: Vec<(RequestId, Purpose)>,
     /// Names the modem's host-interface traffic (bare modem profile).
     decoder: Decoder,
     out: StreetTick,
     campaign: Option<Campaign>,
+    /// When the street's views were last drawn, and whether a change
+    /// waits.
+    shown: Throttle,
+    /// A draw was handed out at a quiet moment of the line: the page lays
+    /// the views out before the next tick sends anything.
+    hold: bool,
 }
 
 impl StreetSession {
@@ -187,6 +208,8 @@ impl StreetSession {
             decoder: Decoder::new(Dialect::St7580, Source::Any),
             out: StreetTick::default(),
             campaign: None,
+            shown: Throttle::new(STREET_DRAW_US),
+            hold: false,
         }
     }
 
@@ -398,7 +421,7 @@ impl StreetSession {
         let now = self.now();
         // Lamps answer in their slots: a frame sent now would collide.
         if self.slots_open(now) {
-            self.held.push((request, purpose));
+            self.held.push((request, Some(purpose)));
             return;
         }
         let id = self.conc.submit(now, request);
@@ -407,17 +430,46 @@ impl StreetSession {
         driver::flush(self, now);
     }
 
+    /// Sends the discovery's or the sweep's next request (`purpose` none:
+    /// a broadcast, whose fate no one waits for), unless the street's
+    /// views are due to be drawn through a bare modem: the line is quiet
+    /// now (the last request's fate known, no window open), so the tick
+    /// stops, the page draws and lays the views out (`Console::tick`),
+    /// and the next tick sends it. A draw while the modem's frames may
+    /// end would hold up their ACKs (T_ACK, UM0932 3.2.8). Through a
+    /// board, the board ACKs its modem: nothing waits.
+    fn send_next(&mut self, now: Instant, q: Request, purpose: Option<Purpose>) {
+        let page = self.drive.tick_at();
+        let changed = self.out.changed || self.out.sent > 0;
+        if self.via_modem() && self.shown.due(changed, page) {
+            self.out.show = self.shown.show_after(true, page, 0.0);
+            self.hold = true;
+            self.held.push((q, purpose));
+            return;
+        }
+        self.send(now, q, purpose);
+    }
+
+    fn send(&mut self, now: Instant, q: Request, purpose: Option<Purpose>) {
+        match purpose {
+            Some(p) => self.submit(q, p),
+            None => {
+                self.conc.submit(now, q);
+            }
+        }
+    }
+
     /// Whether the round's lamps (or new boards) may be answering now.
     fn slots_open(&self, now: Instant) -> bool {
         let window = self.round.as_ref().and_then(|r| r.poll_timeout());
         window.is_some_and(|t| t > now)
     }
 
-    /// Sends what waited for the slots to close.
+    /// Sends what waited for the slots to close or the views' draw.
     fn release_held(&mut self, now: Instant) {
-        if !self.slots_open(now) {
+        if !self.slots_open(now) && !self.hold {
             for (request, purpose) in std::mem::take(&mut self.held) {
-                self.submit(request, purpose);
+                self.send(now, request, purpose);
             }
         }
     }
@@ -427,8 +479,37 @@ impl StreetSession {
         std::mem::take(&mut self.out)
     }
 
+    /// What happened since the last call, without letting time pass, and
+    /// whether the views are to be drawn at the page's clock `page_us`:
+    /// through a bare modem, while the discovery or the sweep has the
+    /// line, at its quiet moments ([`StreetSession::send_next`]) or after
+    /// [`STREET_DRAW_LATE_US`]; else at most every [`STREET_DRAW_US`].
+    pub fn hand_out(&mut self, page_us: f64) -> StreetTick {
+        let busy = self.via_modem() && (self.discovery.is_some() || self.round.is_some());
+        let after = if busy {
+            STREET_DRAW_LATE_US
+        } else {
+            STREET_DRAW_US
+        };
+        let changed = self.out.changed || self.out.sent > 0;
+        self.out.show |= self.shown.show_after(changed, page_us, after);
+        let tick = self.take();
+        // Counted on until the views show it.
+        if !tick.show {
+            self.out.sent = tick.sent;
+        }
+        tick
+    }
+
+    /// Whether the last tick stopped for a draw: the page lays the views
+    /// out before the next tick.
+    pub fn drawing(&self) -> bool {
+        self.hold
+    }
+
     /// Lets the transport's time catch up with the page's clock.
     pub fn tick(&mut self, page_us: f64, budget: Budget) -> StreetTick {
+        self.hold = false;
         if let LinkState::Disconnected(why) = self.state() {
             if self.conc.requester().pending() > 0 {
                 self.conc.abort_all(&why);
@@ -437,7 +518,7 @@ impl StreetSession {
             }
         }
         driver::tick(self, page_us, budget);
-        self.take()
+        self.hand_out(page_us)
     }
 
     /// Runs the street as fast as possible up to `target` (tests).
@@ -445,6 +526,7 @@ impl StreetSession {
     pub fn run_until(&mut self, start: Instant, target: Instant) {
         let mut t = start;
         while t < target && self.drive.transport.is_some() {
+            self.hold = false;
             driver::run_within(self, t, target, Budget::UNLIMITED);
             t = self.now();
         }
@@ -459,6 +541,7 @@ impl StreetSession {
             self.discovery.as_ref().and_then(|d| d.poll_timeout()),
             self.round.as_ref().and_then(|r| r.poll_timeout()),
             self.next_sweep,
+            (!self.held.is_empty() && !self.slots_open(self.now())).then(|| self.now()),
             self.update_timeout(),
             self.drive.transport.as_ref().and_then(|t| t.next_event()),
         ])
@@ -470,14 +553,17 @@ impl StreetSession {
     }
 
     fn run_discovery(&mut self, now: Instant) {
-        let Some(d) = self.discovery.as_mut() else {
+        let Some(d) = self.discovery.as_mut().filter(|_| self.held.is_empty()) else {
             return;
         };
-        if let Some(next) = d.handle_timeout(now) {
-            self.found_before_frame = d.found().len();
-            self.conc.submit(now, next);
+        let next = d.handle_timeout(now);
+        let (found, done) = (d.found().len(), d.is_done());
+        if let Some(next) = next {
+            self.found_before_frame = found;
+            self.out.changed = true;
+            self.send_next(now, next, None);
         }
-        if d.is_done() {
+        if done {
             self.discovery = None;
             self.out.changed = true;
             // A street just found is read at once.
@@ -525,17 +611,15 @@ impl StreetSession {
             self.out.changed = true;
         }
         // One request at a time: the requester paces the line.
-        if self.conc.requester().pending() > 0 {
+        if self.conc.requester().pending() > 0 || !self.held.is_empty() {
             return;
         }
         let Some(round) = self.round.as_mut() else {
             return;
         };
         match round.poll(now) {
-            Some(q) if q.broadcast => {
-                self.conc.submit(now, q);
-            }
-            Some(q) => self.submit(q, Purpose::Round),
+            Some(q) if q.broadcast => self.send_next(now, q, None),
+            Some(q) => self.send_next(now, q, Some(Purpose::Round)),
             None if round.is_done() => {
                 let new = round.found_new();
                 self.round = None;
@@ -807,7 +891,7 @@ impl Layer for StreetSession {
     /// Replies go to the views at the instant they came: a reply may send
     /// the next request.
     fn stop(&self) -> bool {
-        !self.out.replies.is_empty()
+        !self.out.replies.is_empty() || self.hold
     }
 }
 

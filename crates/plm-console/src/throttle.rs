@@ -25,13 +25,24 @@ impl Throttle {
     /// since the last call: at once when it was not shown for a while,
     /// else at the first call once the time is up.
     pub fn show(&mut self, changed: bool, now_us: f64) -> bool {
+        self.show_after(changed, now_us, self.every_us)
+    }
+
+    /// [`Throttle::show`], the view shown again `after_us` after the last
+    /// time at the soonest.
+    pub fn show_after(&mut self, changed: bool, now_us: f64, after_us: f64) -> bool {
         self.waiting |= changed;
-        if !self.waiting || now_us - self.shown_us < self.every_us {
+        if !self.waiting || now_us - self.shown_us < after_us {
             return false;
         }
         self.shown_us = now_us;
         self.waiting = false;
         true
+    }
+
+    /// Whether [`Throttle::show`] would show the view now.
+    pub fn due(&self, changed: bool, now_us: f64) -> bool {
+        (self.waiting || changed) && now_us - self.shown_us >= self.every_us
     }
 }
 

@@ -2,14 +2,6 @@
 
 use super::*;
 
-thread_local! {
-    /// When the street's changes were last shown.
-    static STREET_SHOWN: std::cell::RefCell<Throttle> =
-        const { std::cell::RefCell::new(Throttle::new(STREET_DRAW_US)) };
-    /// Application frames sent to the street and not shown yet.
-    static STREET_SENT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
-}
-
 impl Console {
     pub(super) fn refresh_sim(&self) {
         let (events, echoed, plugged, state, servers) = self.with_active(|t, state| {
@@ -58,36 +50,29 @@ impl Console {
     /// replies (the session is not borrowed any more).
     pub(super) fn apply_street(&self, tick: StreetTick) {
         let StreetTick {
-            changed,
             alerts,
             replies,
             traffic,
             sent,
             campaign,
             found,
+            show,
+            ..
         } = tick;
-        let (sweep, discovering) = {
-            let session = self.street.session();
-            let s = session.borrow();
-            let packed = s
-                .discovering()
-                .map(|(found, left)| ((found as u64) << 32) | left as u64);
-            (s.sweep(), packed)
-        };
         let street = self.street;
         // The progress, the count sent and the lamps are shown together,
         // so that what the page says is of one moment.
-        let progress = street.sweep.with_untracked(|s| *s != sweep)
-            || street.discovering.get_untracked() != discovering;
-        let unshown = STREET_SENT.get() + sent;
-        STREET_SENT.set(unshown);
-        let due = changed || progress || sent > 0;
-        if STREET_SHOWN.with_borrow_mut(|t| t.show(due, page_now_us())) {
+        if show {
+            let (sweep, discovering) = self.street.read(|s| {
+                let packed = s
+                    .discovering()
+                    .map(|(found, left)| ((found as u64) << 32) | left as u64);
+                (s.sweep(), packed)
+            });
             set_if_changed(street.sweep, sweep);
             set_if_changed(street.discovering, discovering);
-            if unshown > 0 {
-                street.sent.update(|n| *n += unshown);
-                STREET_SENT.set(0);
+            if sent > 0 {
+                street.sent.update(|n| *n += sent);
             }
             street.version.update(|v| *v += 1);
             street.keep_history(false);

@@ -5,6 +5,7 @@
 
 use super::*;
 use crate::clock::set_page_now_us;
+use crate::street::{STREET_DRAW_LATE_US, STREET_DRAW_US};
 use crate::transport::LampAction;
 use plm_core::link::Timeouts;
 use plm_core::st7580::mib::index;
@@ -21,13 +22,22 @@ fn console(profile: Profile, speed: u32) -> (Owner, Console) {
     (owner, c)
 }
 
-/// Moves the page's clock in 4 ms steps, ticking at each, until `done`
-/// holds or `limit_s` seconds of the page's clock have passed; whether
-/// `done` held.
+/// Moves the page's clock to each tick, as the page's wake does: when
+/// a session has something due, 4 ms later at most (a busy page's
+/// timers), until `done` holds or `limit_s` seconds of the page's clock
+/// have passed; whether `done` held.
 fn run_until(c: &Console, limit_s: f64, mut done: impl FnMut(&Console) -> bool) -> bool {
     let end = crate::clock::page_now_us() + limit_s * 1e6;
     while !done(c) {
-        let t = crate::clock::page_now_us() + 4_000.0;
+        let now = crate::clock::page_now_us();
+        let wake = [
+            c.session().borrow().next_wake(),
+            c.street.read(|s| s.next_wake()),
+        ]
+        .into_iter()
+        .flatten()
+        .fold(now + 4_000.0, f64::min);
+        let t = wake.max(now + 10.0);
         if t > end {
             return false;
         }
@@ -199,4 +209,42 @@ fn a_stamped_byte_keeps_its_time_and_value() {
     for (at, byte) in [(0, 0), (12_000_345, 0x3f), ((1 << 56) - 1, 0xff)] {
         assert_eq!(unstamped(stamped(at, byte)), (at, byte));
     }
+}
+
+/// A page whose every redraw of the street takes `draw_us` of its clock,
+/// in the street's views' layout ([`crate::wake::lay_out`] at the next
+/// tick, else the browser's next frame), through discovery and two
+/// sweeps over a bare ST7580: the ACKs of the console's host engine, on
+/// the page's clock, and the longest the views went undrawn during
+/// discovery (µs).
+fn acks_with_redraws(draw_us: f64) -> (AckLatency, f64) {
+    let (_owner, c) = console(Profile::StreetModem, 1);
+    let mut version = c.street.version.get_untracked();
+    let (mut drawn, mut longest) = (0.0, 0.0f64);
+    run_until(&c, 30.0, |c| {
+        let v = c.street.version.get_untracked();
+        if v != version {
+            version = v;
+            let now = crate::clock::page_now_us();
+            if c.street.read(|s| s.discovering().is_some()) {
+                longest = longest.max(now - drawn);
+            }
+            drawn = now + draw_us;
+            set_page_now_us(drawn);
+        }
+        c.street.read(|s| s.sweep().rounds > 1)
+    });
+    (c.ack_latency(), longest)
+}
+
+#[test]
+fn the_streets_redraws_come_while_the_line_is_quiet_and_hold_up_no_ack() {
+    let (acks, longest) = acks_with_redraws(10_000.0);
+    assert!(acks.count >= 40, "{acks:?}");
+    assert!(acks.page.p99 < 2_000, "{acks:?}");
+    // The views still follow the street.
+    assert!(
+        longest <= STREET_DRAW_LATE_US + 10_000.0,
+        "{longest} µs undrawn"
+    );
 }

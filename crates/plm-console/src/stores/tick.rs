@@ -52,7 +52,7 @@ impl Console {
         // Notes were handed out since the last tick, and the line waits:
         // the page lays them out now rather than while a frame may be
         // ending ([`crate::session::Session::holds_line`]).
-        if self.session().borrow().drawing() {
+        if self.session().borrow().drawing() || self.street.read(StreetSession::drawing) {
             crate::wake::lay_out();
         }
         let budget = || Budget::wall(page_now_us, TICK_BUDGET_US);
@@ -81,7 +81,7 @@ impl Console {
     pub(super) fn refresh(&self) {
         crate::wake::soon();
         let tick = self.session().borrow_mut().take_due(page_now_us());
-        let street = self.street.session().borrow_mut().take();
+        let street = self.street.session().borrow_mut().hand_out(page_now_us());
         let (state, kind, port) = self.with_active(|t, state| {
             let (kind, port) = t.map_or((String::new(), String::new()), |t| {
                 (t.kind().into(), t.port())
