@@ -145,7 +145,8 @@ pub struct StreetTick {
     /// The update campaign changed (to save it, and to show it).
     pub campaign: bool,
     /// The street found changed: a lamp heard, a new session, a new
-    /// release (to remember it, [`StreetSession::remembered`]).
+    /// release (to remember it, [`StreetSession::remembered`]; in
+    /// [`StreetSession::hand_out`]'s ticks, when the views are drawn).
     pub found: bool,
     /// The street's views are to be drawn now (at most every
     /// [`STREET_DRAW_US`]).
@@ -494,9 +495,11 @@ impl StreetSession {
         let changed = self.out.changed || self.out.sent > 0;
         self.out.show |= self.shown.show_after(changed, page_us, after);
         let tick = self.take();
-        // Counted on until the views show it.
+        // Counted on until the views show it; the street found is kept
+        // then too (the browser's storage written at a quiet moment).
         if !tick.show {
             self.out.sent = tick.sent;
+            self.out.found = tick.found;
         }
         tick
     }
