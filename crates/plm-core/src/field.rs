@@ -63,15 +63,22 @@ pub struct Field {
     pub settable: bool,
     /// A raw value that means "no value" (UM0932 Table 39: SNR 255 for
     /// FSK frames); it reads as [`Value::Absent`].
-    pub absent: Option<u64>,
-    /// When set, `absent` means "no value" only while this other field of
-    /// the same bytes holds this value (Table 39: SNR 255 has no meaning
-    /// for FSK frames only; for PSK frames it is -1 dB).
-    pub absent_if: Option<(&'static Field, i64)>,
+    pub absent: Option<&'static Absent>,
     /// How the seed reads the raw number in its unit (ST7570 UM 3.6.1:
     /// S0 in dBµV is the raw value / 100); `None` when the number is read
     /// as it is.
-    pub scale: Option<Scale>,
+    pub scale: Option<&'static Scale>,
+}
+
+/// A raw value that means "no value" ([`Field::absent`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Absent {
+    /// The raw value.
+    pub raw: u64,
+    /// When set, `raw` means "no value" only while this other field of
+    /// the same bytes holds this value (Table 39: SNR 255 has no meaning
+    /// for FSK frames only; for PSK frames it is -1 dB).
+    pub only_while: Option<(&'static Field, i64)>,
 }
 
 /// A raw number read in the seed's unit: `raw × factor` `unit`, given to
@@ -211,7 +218,6 @@ impl Field {
             max: 0,
             settable: true,
             absent: None,
-            absent_if: None,
             scale: None,
         }
     }
@@ -304,7 +310,7 @@ impl Field {
 
     /// The same field read in the seed's unit through `scale` (the raw
     /// number keeps [`Field::unit`]).
-    pub const fn scaled(mut self, scale: Scale) -> Field {
+    pub const fn scaled(mut self, scale: &'static Scale) -> Field {
         self.scale = Some(scale);
         self
     }
@@ -317,16 +323,8 @@ impl Field {
     }
 
     /// The same field with a raw value that means "no value".
-    pub const fn absent_when(mut self, raw: u64) -> Field {
-        self.absent = Some(raw);
-        self
-    }
-
-    /// The same field with a raw value that means "no value" only while
-    /// `other` holds `value`.
-    pub const fn absent_when_with(mut self, raw: u64, other: &'static Field, value: i64) -> Field {
-        self.absent = Some(raw);
-        self.absent_if = Some((other, value));
+    pub const fn absent_when(mut self, absent: &'static Absent) -> Field {
+        self.absent = Some(absent);
         self
     }
 
@@ -389,12 +387,11 @@ impl Field {
 
     /// Reads the field as a typed [`Value`]; `None` if `data` is too short.
     pub fn read(&self, data: &[u8]) -> Option<Value> {
-        if self.absent.is_some()
-            && self.raw(data) == self.absent
-            && self
-                .absent_if
-                .is_none_or(|(other, value)| other.get(data) == Some(value))
-        {
+        if self.absent.is_some_and(|a| {
+            self.raw(data) == Some(a.raw)
+                && a.only_while
+                    .is_none_or(|(other, value)| other.get(data) == Some(value))
+        }) {
             return Some(Value::Absent);
         }
         Some(match self.kind {
@@ -649,7 +646,7 @@ mod tests {
         let f = Field::uint("s0", "S0", 0, 3)
             .order(Order::LsbFirst)
             .unit("0.01 dBµV")
-            .scaled(HUNDREDTHS);
+            .scaled(&HUNDREDTHS);
         // ST7570 UM 9 step 2: S0 F6.19.00h = 6646 = 66.46 dBµV.
         let v = f.read(&[0xF6, 0x19, 0x00]).unwrap();
         assert_eq!(f.reading(&v).as_deref(), Some("66.46"));

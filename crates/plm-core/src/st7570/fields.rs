@@ -30,7 +30,7 @@ pub const SNR_DB: Scale = Scale {
 
 /// A number in 0.01 dBµV (S0..N1, S, N, AL_*, thresholds), read in dBµV.
 pub const fn in_dbuv(f: Field) -> Field {
-    f.unit(SN_UNIT).scaled(DBUV)
+    f.unit(SN_UNIT).scaled(&DBUV)
 }
 
 /// dBµV RMS of a raw signal or noise estimation (3.6.1, Equation 1).
@@ -188,7 +188,7 @@ const fn fsk(offset: usize) -> Field {
 const fn snr(name: &'static str, label: &'static str, offset: usize) -> Field {
     le(Field::uint(name, label, offset, 3))
         .unit(SNR_UNIT)
-        .scaled(SNR_DB)
+        .scaled(&SNR_DB)
 }
 const fn mac_address(name: &'static str, label: &'static str, offset: usize) -> Field {
     le(Field::uint(name, label, offset, 2)).range(0, 0xFFF)

@@ -2,7 +2,7 @@
 //! and the enumerations they use. Each `LAYOUT` is the one description of
 //! its table: typed codecs, the decoder and forms all read it.
 
-use crate::field::Field;
+use crate::field::{Absent, Field};
 
 /// Frame modulation names (Tables 35, 39, 45, 48, 56), index = raw value.
 pub const MODULATIONS: &[&str] = &[
@@ -255,11 +255,12 @@ pub mod indication_data {
     /// Byte 1: signed dB, "valid for PSK received frames only, equal to
     /// 255 – no meaning – for FSK received frames" (Tables 39, 48): 255 is
     /// no value after a B-FSK frame, and -1 dB after a PSK one.
-    pub const SNR: Field = Field::int("snr", "SNR", 1, 1).unit("dB").absent_when_with(
-        0xFF,
-        &FRAME_MODULATION,
-        3, // B-FSK
-    );
+    pub const SNR: Field = Field::int("snr", "SNR", 1, 1)
+        .unit("dB")
+        .absent_when(&Absent {
+            raw: 0xFF,
+            only_while: Some((&FRAME_MODULATION, 3)), // B-FSK
+        });
     /// Bytes 2-3, signed, 13 µs steps.
     pub const ZC_DELAY: Field = Field::int("zc_delay", "ZC delay", 2, 2).unit("13 µs");
     /// Bytes 0-3 of Table 39.
