@@ -196,10 +196,10 @@ fn reset_mid_request_ends_it_once() {
         let ticket = d.submit(&faulty::write(0x4242));
         d.run_for(at);
         let now = d.now();
-        d.modem.set_resetn(now, true);
+        d.port.modem.set_resetn(now, true);
         d.run_for(MS);
         let now = d.now();
-        d.modem.set_resetn(now, false);
+        d.port.modem.set_resetn(now, false);
         d.run_until(
             10 * SEC,
             |e| matches!(e, Event::Delivered(t) | Event::Failed(t, _) if *t == ticket),

@@ -302,7 +302,7 @@ fn reset_with_and_without_auto_reconfiguration() {
     // A hardware reset restores too, and the status says so.
     configure(&mut d, mode::CLIENT, PHY);
     let now = d.now();
-    d.modem.hardware_reset(now);
+    d.port.modem.hardware_reset(now);
     d.run_for(50 * MS);
     assert_eq!(read(&mut d, 0x00A1), Ok(plc(mode::CLIENT, PHY)));
     assert!(!status(&d).reset);
@@ -321,13 +321,13 @@ fn status_bits_follow_mode_and_layer() {
     assert!(s.synchronized());
     // Without the zero crossing there are no slots (ZC_FAIL, LP_NS).
     let now = d.now();
-    d.modem.set_zc_fail(now, true);
+    d.port.modem.set_zc_fail(now, true);
     let s = fresh_status(&mut d);
     assert!(s.zc_fail && !s.synchronized());
     let p_sdu = Command::PhyDataRequest { p_sdu: vec![0; 38] };
     assert_eq!(data_confirm(&mut d, p_sdu), 0x04);
     let now = d.now();
-    d.modem.set_zc_fail(now, false);
+    d.port.modem.set_zc_fail(now, false);
     assert!(fresh_status(&mut d).synchronized());
     // A MAC Client is synchronized by its first transmission (10.3.1).
     configure(&mut d, mode::CLIENT, MAC);
@@ -360,18 +360,18 @@ fn status_bits_follow_mode_and_layer() {
     // Monitor and Test modes.
     configure(&mut d, mode::MONITOR, PHY);
     assert_eq!(fresh_status(&mut d).mode, mode::MONITOR);
-    assert_eq!(d.modem.test_tone(), None);
+    assert_eq!(d.port.modem.test_tone(), None);
     configure(&mut d, 4, PHY);
     assert_eq!(fresh_status(&mut d).mode, 0, "Test modes share MODE 0");
     // Table 137: a continuous tone on ch.0, ch.1, or both in turn.
     let p = PlcConfiguration::decode(&plc(0, PHY));
     assert_eq!(
-        d.modem.test_tone(),
+        d.port.modem.test_tone(),
         Some((TestTone::Single(p.f0), p.target_output_gain))
     );
     configure(&mut d, 6, PHY);
     assert_eq!(
-        d.modem.test_tone(),
+        d.port.modem.test_tone(),
         Some((TestTone::Alternate(p.f0, p.f1), 0x10))
     );
     let p_sdu = Command::PhyDataRequest { p_sdu: vec![0; 38] };
@@ -541,7 +541,7 @@ fn data_requests_leave_on_the_line_seam_in_time_slots() {
         ),
         0xFF
     );
-    let tx = d.modem.poll_line().expect("a PHY frame");
+    let tx = d.port.modem.poll_line().expect("a PHY frame");
     assert_eq!(tx.slot, 300 * MS, "50 Hz, 1200 bit/s");
     assert!(
         tx.start > t0 && tx.start.is_multiple_of(tx.slot),
@@ -557,7 +557,7 @@ fn data_requests_leave_on_the_line_seam_in_time_slots() {
     configure(&mut d, mode::CLIENT, MAC);
     let m_sdu = vec![0xA5; 100];
     assert_eq!(data_confirm(&mut d, mac_request(2, 0x123, &m_sdu)), 0xFF);
-    let tx = d.modem.poll_line().expect("a MAC frame");
+    let tx = d.port.modem.poll_line().expect("a MAC frame");
     let subframes: Vec<[u8; 38]> = tx
         .slots
         .iter()
@@ -602,7 +602,7 @@ fn a_phy_server_synchronizes_on_what_it_hears() {
         snr: (100, 200),
     };
     let now = d.now();
-    assert!(d.modem.hear(now, &heard));
+    assert!(d.port.modem.hear(now, &heard));
     d.run_for(100 * MS);
     let frames = d.frames(Layer::Phy);
     assert!(frames
@@ -633,7 +633,7 @@ fn a_phy_server_synchronizes_on_what_it_hears() {
     assert_eq!(read(&mut d, 0x000E), Ok(le(&[9100, 3100, 1])));
     // Half duplex: the rest of its own slot, it hears nothing.
     let now = d.now();
-    assert!(!d.modem.hear(now, &heard));
+    assert!(!d.port.modem.hear(now, &heard));
 }
 
 #[test]
@@ -647,7 +647,10 @@ fn alarms_heard_are_counted_indicated_and_flagged_once() {
         n1: 2100,
     };
     let now = d.now();
-    assert!(!d.modem.hear_alarm(now, sn), "not synchronized: no slots");
+    assert!(
+        !d.port.modem.hear_alarm(now, sn),
+        "not synchronized: no slots"
+    );
     configure(&mut d, mode::CLIENT, PHY);
     let slot = 300 * MS;
     // The alarm window of slot k: its last 3 bytes.
@@ -656,7 +659,7 @@ fn alarms_heard_are_counted_indicated_and_flagged_once() {
     let alarm_in = |d: &mut ModemDriver, at: u64| {
         d.run_for(at - d.now());
         let now = d.now();
-        d.modem.hear_alarm(now, sn)
+        d.port.modem.hear_alarm(now, sn)
     };
     let at = window(k);
     assert!(alarm_in(&mut d, at));
@@ -740,7 +743,7 @@ fn a_phy_monitor_searches_slot_by_slot_until_it_hears_a_subframe() {
         snr: (6, 7),
     };
     let now = d.now();
-    assert!(d.modem.hear(now, &heard));
+    assert!(d.port.modem.hear(now, &heard));
     d.run_for(3_000 * MS);
     assert_eq!(
         searching(&d).len(),

@@ -64,8 +64,8 @@ impl SfskTransport {
                 Some(SimServer {
                     node: i + 1,
                     address: r.address,
-                    repeater: matches!(n.driver.modem.mib().byte(0x000B, 0) & 0x03, 1 | 3),
-                    synchronized: n.driver.modem.synchronized(),
+                    repeater: matches!(n.driver.port.modem.mib().byte(0x000B, 0) & 0x03, 1 | 3),
+                    synchronized: n.driver.port.modem.synchronized(),
                     cut_off: n.extra_noise_dbuv.is_some(),
                     indicated: r.indicated,
                     answered: r.answered,

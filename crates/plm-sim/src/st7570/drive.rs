@@ -1,17 +1,20 @@
 //! plm-core's host engine driving one simulated ST7570 over a byte-level
-//! UART in virtual time (ST7570 UM 5.1-5.2), as [`crate::drive`] does for
-//! the ST7580 world: one node of the S-FSK network ([`super::net`]), or a
-//! modem alone in tests.
+//! UART in virtual time (ST7570 UM 5.1-5.2), on plm-core's one drive loop
+//! ([`turn`]) as [`crate::drive`] does for the ST7580 world: the modem
+//! and its UART are the host's port ([`ModemPort`]); one node of the
+//! S-FSK network ([`super::net`]), or a modem alone in tests.
 
 use super::St7570;
 use crate::rng::Rng;
 use crate::sim::Dir;
 use crate::uart::Wire;
-use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket, Transmit};
+use plm_core::drive::{turn, Io};
+use plm_core::link::host::{Event, HostConfig, HostEngine, LinkError, Ticket};
 use plm_core::link::Dialect;
 use plm_core::st7570::{code, Command, Layer};
 use plm_core::time::{earliest, Duration, Instant};
 use std::collections::VecDeque;
+use std::convert::Infallible;
 
 /// What became of a request.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -24,15 +27,13 @@ pub enum Outcome {
     TimedOut,
 }
 
-/// A host engine joined to one ST7570 by a UART in each direction.
+/// One ST7570 and the UART to it, as its host's serial port sees them:
+/// the host writes bytes and T_REQ levels and reads the modem's bytes
+/// ([`ModemPort::host_read`], or plm-core's [`Io`]).
 #[derive(Debug, Clone)]
-pub struct ModemDriver {
+pub struct ModemPort {
     /// The modem.
     pub modem: St7570,
-    /// The host's link engine (ST7570 dialect).
-    pub host: HostEngine,
-    /// Every host event so far, with its time.
-    pub events: Vec<(Instant, Event)>,
     now: Instant,
     to_modem: Wire,
     to_host: Wire,
@@ -43,26 +44,17 @@ pub struct ModemDriver {
     /// T_REQ levels, each taking effect once the bytes written before it
     /// have left the UART (a driver drains its FIFO before touching RTS).
     treq: VecDeque<(Instant, bool)>,
-    /// The host is outside ([`ModemDriver::serve_outside`]): the modem's
-    /// bytes wait here, with their arrival times, instead of going to
-    /// [`ModemDriver::host`].
-    outside: Option<Vec<(Instant, u8)>>,
+    /// The modem's bytes that reached the host, not yet read, with their
+    /// arrival times.
+    rx: Vec<(Instant, u8)>,
 }
 
-impl ModemDriver {
-    /// A modem powered on at 0 and a host with the reset timeouts, both at
-    /// `baud`.
-    pub fn new(baud: u32) -> Self {
-        Self::with_seed(baud, 0x7570)
-    }
-
-    /// As [`ModemDriver::new`], the UART faults (none by default) drawing
-    /// on an RNG seeded with `seed`.
-    pub fn with_seed(baud: u32, seed: u64) -> Self {
-        ModemDriver {
+impl ModemPort {
+    /// A modem powered on at 0 at `baud`, the UART faults (none by
+    /// default) drawing on an RNG seeded with `seed`.
+    pub fn new(baud: u32, seed: u64) -> Self {
+        ModemPort {
             modem: St7570::new(baud, 0),
-            host: HostEngine::new(Dialect::St7570, HostConfig::at_reset(Dialect::St7570, baud)),
-            events: Vec::new(),
             now: 0,
             to_modem: Wire::new(baud),
             to_host: Wire::new(baud),
@@ -70,44 +62,36 @@ impl ModemDriver {
             at_modem: VecDeque::new(),
             at_host: VecDeque::new(),
             treq: VecDeque::new(),
-            outside: None,
+            rx: Vec::new(),
         }
     }
 
-    /// From now on the host is outside (`plm sim`'s client, the console):
-    /// it writes bytes and T_REQ levels ([`ModemDriver::write`],
-    /// [`ModemDriver::set_treq`]) and reads the modem's bytes
-    /// ([`ModemDriver::host_read`]); [`ModemDriver::host`] stays idle.
-    pub fn serve_outside(&mut self) {
-        self.outside.get_or_insert_with(Vec::new);
+    /// Virtual time now.
+    pub fn now(&self) -> Instant {
+        self.now
     }
 
-    /// Whether the host is outside.
-    pub fn is_outside(&self) -> bool {
-        self.outside.is_some()
-    }
-
-    /// The outside host writes `bytes` on the UART now.
+    /// The host writes `bytes` on the UART now.
     pub fn write(&mut self, bytes: &[u8]) {
         let arrivals = self.to_modem.write(self.now, bytes, &mut self.rng);
         self.at_modem.extend(arrivals);
     }
 
-    /// The outside host sets T_REQ (`asserted`: low), once the bytes it
-    /// wrote before have left the UART.
+    /// The host sets T_REQ (`asserted`: low), once the bytes it wrote
+    /// before have left the UART.
     pub fn set_treq(&mut self, asserted: bool) {
         let at = self.to_modem.drained_at(self.now);
         self.treq.push_back((at, asserted));
     }
 
-    /// How long until the bytes the outside host wrote so far have all
-    /// reached the modem.
+    /// How long until the bytes the host wrote so far have all reached
+    /// the modem.
     pub fn backlog_to_modem(&self) -> Duration {
         self.to_modem.drained_at(self.now) - self.now
     }
 
-    /// Purges the outside host's transmit side (its serial driver dropping
-    /// its buffer): the bytes it wrote that have not yet reached the modem
+    /// Purges the host's transmit side (its serial driver dropping its
+    /// buffer): the bytes it wrote that have not yet reached the modem
     /// are lost, and a T_REQ change waiting behind them takes effect now,
     /// at the level the host set last. The modem runs on.
     pub fn purge_to_modem(&mut self) {
@@ -119,21 +103,16 @@ impl ModemDriver {
         }
     }
 
-    /// Purges the outside host's receive side: the modem's bytes that
-    /// reached it and are not yet read, and those on their way to it.
+    /// Purges the host's receive side: the modem's bytes that reached it
+    /// and are not yet read, and those on their way to it.
     pub fn purge_to_host(&mut self) {
         self.at_host.clear();
-        if let Some(out) = self.outside.as_mut() {
-            out.clear();
-        }
+        self.rx.clear();
     }
 
-    /// The modem's bytes that reached the outside host by now.
+    /// The modem's bytes that reached the host by now.
     pub fn host_read(&mut self) -> Vec<(Instant, u8)> {
-        self.outside
-            .as_mut()
-            .map(std::mem::take)
-            .unwrap_or_default()
+        std::mem::take(&mut self.rx)
     }
 
     /// The UART baud rate (both ways; the modem's BR0/BR1 strapped to it).
@@ -159,66 +138,187 @@ impl ModemDriver {
         }
     }
 
+    /// The next moment something is due at the modem or on a wire.
+    pub fn next_due(&self) -> Option<Instant> {
+        let wires = earliest(
+            self.at_modem.front().map(|b| b.0),
+            self.at_host.front().map(|b| b.0),
+        );
+        let modem = earliest(self.modem.poll_timeout(), self.treq.front().map(|t| t.0));
+        earliest(wires, modem)
+    }
+
+    /// Moves virtual time to `t` (never back), delivers what is due and
+    /// hands the modem's output to its wire.
+    pub fn advance(&mut self, t: Instant) {
+        self.now = self.now.max(t);
+        let now = self.now;
+        while let Some(&(at, b)) = self.at_modem.front().filter(|(at, _)| *at <= now) {
+            self.at_modem.pop_front();
+            self.modem.handle_rx(at, &[b]);
+        }
+        // A level change and a byte at the same instant: the byte left
+        // first (the host touches RTS once its FIFO is drained).
+        while let Some(&(at, asserted)) = self.treq.front().filter(|(at, _)| *at <= now) {
+            self.treq.pop_front();
+            self.modem.set_treq(at, asserted);
+        }
+        while let Some(&b) = self.at_host.front().filter(|(at, _)| *at <= now) {
+            self.at_host.pop_front();
+            self.rx.push(b);
+        }
+        if self.modem.poll_timeout().is_some_and(|t| t <= now) {
+            self.modem.handle_timeout(now);
+        }
+        self.flush(now);
+    }
+
+    /// Hands the modem's output to its wire after something outside (the
+    /// line, the host) acted at `now` (never back).
+    pub fn flush(&mut self, now: Instant) {
+        self.now = self.now.max(now);
+        while let Some(b) = self.modem.poll_transmit() {
+            let arrivals = self.to_host.write(self.now, &b, &mut self.rng);
+            self.at_host.extend(arrivals);
+        }
+    }
+}
+
+/// The port as plm-core's drive loop sees it: time passes as fast as the
+/// loop asks, to the next thing that happens at the modem or on a wire.
+impl Io for ModemPort {
+    type Error = Infallible;
+    fn now(&self) -> Instant {
+        self.now
+    }
+    fn wait(&mut self, until: Instant, rx: &mut Vec<(Instant, u8)>) -> Result<(), Infallible> {
+        let next = self
+            .next_due()
+            .unwrap_or(until)
+            .clamp(self.now, until.max(self.now));
+        self.advance(next);
+        rx.extend(self.host_read());
+        Ok(())
+    }
+    fn write(&mut self, bytes: &[u8]) -> Result<(), Infallible> {
+        ModemPort::write(self, bytes);
+        Ok(())
+    }
+    fn set_treq(&mut self, asserted: bool) -> Result<(), Infallible> {
+        ModemPort::set_treq(self, asserted);
+        Ok(())
+    }
+}
+
+/// A host engine joined to one ST7570 by a UART in each direction.
+#[derive(Debug, Clone)]
+pub struct ModemDriver {
+    /// The modem and its UART.
+    pub port: ModemPort,
+    /// The host's link engine (ST7570 dialect).
+    pub host: HostEngine,
+    /// Every host event so far, with its time.
+    pub events: Vec<(Instant, Event)>,
+    /// The host is outside ([`ModemDriver::serve_outside`]).
+    outside: bool,
+}
+
+impl ModemDriver {
+    /// A modem powered on at 0 and a host with the reset timeouts, both at
+    /// `baud`.
+    pub fn new(baud: u32) -> Self {
+        Self::with_seed(baud, 0x7570)
+    }
+
+    /// As [`ModemDriver::new`], the UART faults (none by default) drawing
+    /// on an RNG seeded with `seed`.
+    pub fn with_seed(baud: u32, seed: u64) -> Self {
+        ModemDriver {
+            port: ModemPort::new(baud, seed),
+            host: HostEngine::new(Dialect::St7570, HostConfig::at_reset(Dialect::St7570, baud)),
+            events: Vec::new(),
+            outside: false,
+        }
+    }
+
+    /// From now on the host is outside (`plm sim`'s client, the console):
+    /// it drives [`ModemDriver::port`] itself, and [`ModemDriver::host`]
+    /// stays idle.
+    pub fn serve_outside(&mut self) {
+        self.outside = true;
+    }
+
+    /// Whether the host is outside.
+    pub fn is_outside(&self) -> bool {
+        self.outside
+    }
+
     /// Virtual time now.
     pub fn now(&self) -> Instant {
-        self.now
+        self.port.now
+    }
+
+    /// One direction of the UART, for fault injection.
+    pub fn wire(&mut self, dir: Dir) -> &mut Wire {
+        self.port.wire(dir)
     }
 
     /// Queues a command for the modem.
     pub fn submit(&mut self, cmd: &Command) -> Ticket {
-        self.host.submit(self.now, cmd.to_frame())
+        self.host.submit(self.port.now, cmd.to_frame())
     }
 
     /// Runs until `done` holds for a host event or `limit` µs have passed;
     /// returns whether `done` held.
     pub fn run_until(&mut self, limit: Duration, mut done: impl FnMut(&Event) -> bool) -> bool {
-        let end = self.now + limit;
+        let end = self.port.now + limit;
         let mut seen = self.events.len();
         loop {
-            self.move_bytes();
             while seen < self.events.len() {
                 seen += 1;
                 if done(&self.events[seen - 1].1) {
                     return true;
                 }
             }
-            match self.next_due() {
-                Some(t) if t <= end => self.now = self.now.max(t),
-                _ => {
-                    self.now = end;
-                    return false;
-                }
+            if self.port.now >= end {
+                return false;
             }
-            self.step();
+            self.turn(end);
         }
     }
 
-    /// The next moment something is due on either side or on a wire.
-    pub fn next_due(&self) -> Option<Instant> {
-        [
-            self.host.poll_timeout(),
-            self.modem.poll_timeout(),
-            self.at_modem.front().map(|b| b.0),
-            self.at_host.front().map(|b| b.0),
-            self.treq.front().map(|t| t.0),
-        ]
-        .into_iter()
-        .fold(None, earliest)
+    /// One turn of plm-core's drive loop: time runs to `until` at most, to
+    /// the next thing due at the host, the modem or a wire. The port stops
+    /// at each byte's arrival, so every event of the turn is at its end.
+    fn turn(&mut self, until: Instant) {
+        let Ok(now) = turn(&mut self.host, &mut self.port, until, |_, _| {});
+        self.events
+            .extend(std::iter::from_fn(|| self.host.poll_event()).map(|e| (now, e)));
     }
 
-    /// Moves virtual time to `t` (never back), runs what is due and hands
-    /// the outputs on: a network steps its nodes with this.
+    /// The next moment something is due at the host (unless it is
+    /// outside), the modem or a wire.
+    pub fn next_due(&self) -> Option<Instant> {
+        let host = self.host.poll_timeout().filter(|_| !self.outside);
+        earliest(self.port.next_due(), host)
+    }
+
+    /// Moves virtual time to `t` (never back) and runs what is due: a
+    /// network steps its nodes with this.
     pub fn advance(&mut self, t: Instant) {
-        self.now = self.now.max(t);
-        self.step();
-        self.move_bytes();
+        match self.outside {
+            true => self.port.advance(t),
+            false => self.turn(t),
+        }
     }
 
     /// Hands on what either side has to say after something outside (the
     /// line, a host program) acted at `now` (never back).
     pub fn flush(&mut self, now: Instant) {
-        self.now = self.now.max(now);
-        self.move_bytes();
+        self.port.flush(now);
+        if !self.outside {
+            self.turn(self.port.now);
+        }
     }
 
     /// Runs for `d` µs.
@@ -229,7 +329,7 @@ impl ModemDriver {
     /// Sends `cmd` and waits up to `limit` µs for the answer that closes
     /// it in the modem's current access layer (`code::answers`).
     pub fn request(&mut self, cmd: &Command, limit: Duration) -> Outcome {
-        let layer = self.modem.layer();
+        let layer = self.port.modem.layer();
         let ticket = self.submit(cmd);
         let request = cmd.code();
         let mut out = Outcome::TimedOut;
@@ -256,57 +356,5 @@ impl ModemDriver {
                 _ => None,
             })
             .collect()
-    }
-
-    /// Delivers what is due at `now` to both sides.
-    fn step(&mut self) {
-        let now = self.now;
-        while let Some(&(at, b)) = self.at_modem.front().filter(|(at, _)| *at <= now) {
-            self.at_modem.pop_front();
-            self.modem.handle_rx(at, &[b]);
-        }
-        // A level change and a byte at the same instant: the byte left
-        // first (the host touches RTS once its FIFO is drained).
-        while let Some(&(at, asserted)) = self.treq.front().filter(|(at, _)| *at <= now) {
-            self.treq.pop_front();
-            self.modem.set_treq(at, asserted);
-        }
-        while let Some(&(at, b)) = self.at_host.front().filter(|(at, _)| *at <= now) {
-            self.at_host.pop_front();
-            match self.outside.as_mut() {
-                Some(out) => out.push((at, b)),
-                None => self.host.handle_rx(at, &[b]),
-            }
-        }
-        if self.modem.poll_timeout().is_some_and(|t| t <= now) {
-            self.modem.handle_timeout(now);
-        }
-        if self.host.poll_timeout().is_some_and(|t| t <= now) {
-            self.host.handle_timeout(now);
-        }
-    }
-
-    /// Hands each side's output to its wire, and T_REQ to the modem.
-    fn move_bytes(&mut self) {
-        let now = self.now;
-        while let Some(t) = self.host.poll_transmit() {
-            match t {
-                Transmit::Bytes(b) => {
-                    let arrivals = self.to_modem.write(now, &b, &mut self.rng);
-                    self.at_modem.extend(arrivals);
-                }
-                Transmit::TReq { asserted } => {
-                    let at = self.to_modem.drained_at(now);
-                    self.treq.push_back((at, asserted));
-                }
-            }
-        }
-        while let Some(b) = self.modem.poll_transmit() {
-            let arrivals = self.to_host.write(now, &b, &mut self.rng);
-            self.at_host.extend(arrivals);
-        }
-        while let Some(e) = self.host.poll_event() {
-            self.events.push((now, e));
-        }
     }
 }

@@ -155,7 +155,7 @@ impl Network {
         let nodes = (0..config.nodes)
             .map(|i| {
                 let mut driver = ModemDriver::with_seed(config.baud, rng.next_u64());
-                driver.modem.set_timeout_scale(config.timeout_scale);
+                driver.port.modem.set_timeout_scale(config.timeout_scale);
                 if i < config.served {
                     driver.serve_outside();
                 }
@@ -198,7 +198,7 @@ impl Network {
 
     /// Node `i`'s modem.
     pub fn modem(&self, i: usize) -> &St7570 {
-        &self.nodes[i].driver.modem
+        &self.nodes[i].driver.port.modem
     }
 
     /// Node `i`'s driver (modem and host engine).
@@ -217,7 +217,7 @@ impl Network {
     /// faster from now on, so that a demo sees a timeout of minutes.
     pub fn set_timeout_scale(&mut self, scale: u64) {
         for n in &mut self.nodes {
-            n.driver.modem.set_timeout_scale(scale);
+            n.driver.port.modem.set_timeout_scale(scale);
         }
     }
 
@@ -338,7 +338,7 @@ impl Network {
         let now = self.now;
         let d = &mut self.nodes[i].driver;
         d.flush(now);
-        d.modem.set_resetn(now, low);
+        d.port.modem.set_resetn(now, low);
         d.flush(now);
     }
 
@@ -353,7 +353,7 @@ impl Network {
             node.driver.flush(now);
         }
         self.refresh_node(i);
-        while let Some(tx) = self.nodes[i].driver.modem.poll_line() {
+        while let Some(tx) = self.nodes[i].driver.port.modem.poll_line() {
             self.schedule(&tx);
             self.on_air.push(OnAir { node: i, tx });
         }
@@ -366,7 +366,7 @@ impl Network {
         let now = self.now;
         let line = &self.line;
         let node = &mut self.nodes[i];
-        let m = &mut node.driver.modem;
+        let m = &mut node.driver.port.modem;
         let fail = node.mains_lost || m.mib().plc().mains_60_hz != line.mains_60_hz;
         if fail != m.zc_fail() {
             m.set_zc_fail(now, fail);
@@ -375,6 +375,7 @@ impl Network {
         let noise = self.noise_at(i);
         self.nodes[i]
             .driver
+            .port
             .modem
             .set_line_noise(line::signal_noise(noise, 0.0, noise));
     }
@@ -438,7 +439,7 @@ impl Network {
             .on_air
             .iter()
             .filter(|a| a.tx.slot == slot && a.tx.start <= start && start < a.tx.end())
-            .filter(|a| self.nodes[a.node].driver.modem.is_on())
+            .filter(|a| self.nodes[a.node].driver.port.modem.is_on())
             .map(|a| {
                 let k = ((start - a.tx.start) / slot) as usize;
                 (
@@ -456,8 +457,8 @@ impl Network {
         }
         let slot_number = start / slot;
         for r in 0..self.nodes.len() {
-            let plc = self.nodes[r].driver.modem.mib().plc();
-            let rx_slot = self.nodes[r].driver.modem.slots().slot;
+            let plc = self.nodes[r].driver.port.modem.mib().plc();
+            let rx_slot = self.nodes[r].driver.port.modem.slots().slot;
             if rx_slot != slot {
                 continue;
             }
@@ -484,8 +485,8 @@ impl Network {
                 continue;
             }
             let noise = self.noise_at(r);
-            let max_pga = self.nodes[r].driver.modem.mib().byte(0x00AB, 0).min(8);
-            let modem = &mut self.nodes[r].driver.modem;
+            let max_pga = self.nodes[r].driver.port.modem.mib().byte(0x00AB, 0).min(8);
+            let modem = &mut self.nodes[r].driver.port.modem;
             if window {
                 if let Some(sn) = line::receive_alarm(&signals, noise) {
                     modem.hear_alarm(now, sn);
@@ -536,7 +537,7 @@ impl Ports for Network {
         let now = self.now;
         if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
             n.driver.flush(now);
-            n.driver.write(bytes);
+            n.driver.port.write(bytes);
         }
     }
 
@@ -544,7 +545,7 @@ impl Ports for Network {
         let now = self.now;
         if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
             n.driver.flush(now);
-            n.driver.set_treq(asserted);
+            n.driver.port.set_treq(asserted);
         }
     }
 
@@ -555,7 +556,7 @@ impl Ports for Network {
     }
 
     fn baud_of(&self, node: usize) -> u32 {
-        self.nodes[node].driver.baud()
+        self.nodes[node].driver.port.baud()
     }
 
     fn set_baud_of(&mut self, node: usize, baud: u32) {
@@ -563,7 +564,7 @@ impl Ports for Network {
             let now = self.now;
             let d = &mut self.nodes[node].driver;
             d.flush(now);
-            d.set_baud(baud);
+            d.port.set_baud(baud);
         }
     }
 
@@ -573,7 +574,7 @@ impl Ports for Network {
             .get(node)
             .filter(|n| n.driver.is_outside())
             .map_or(0, |n| {
-                let left = n.driver.backlog_to_modem() + n.driver.now();
+                let left = n.driver.port.backlog_to_modem() + n.driver.now();
                 left.saturating_sub(self.now)
             })
     }
@@ -582,7 +583,7 @@ impl Ports for Network {
         let now = self.now;
         if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
             n.driver.flush(now);
-            n.driver.purge_to_modem();
+            n.driver.port.purge_to_modem();
         }
     }
 
@@ -590,14 +591,14 @@ impl Ports for Network {
         let now = self.now;
         if let Some(n) = self.nodes.get_mut(node).filter(|n| n.driver.is_outside()) {
             n.driver.flush(now);
-            n.driver.purge_to_host();
+            n.driver.port.purge_to_host();
         }
     }
 
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         self.nodes
             .get_mut(node)
-            .map_or_else(Vec::new, |n| n.driver.host_read())
+            .map_or_else(Vec::new, |n| n.driver.port.host_read())
     }
 
     fn next_deadline(&self) -> Option<Instant> {

@@ -134,7 +134,7 @@ impl Responder {
         if d.events.is_empty() && (self.waiting.is_some() || self.queue.is_empty()) {
             return;
         }
-        let layer = d.modem.layer();
+        let layer = d.port.modem.layer();
         for (at, e) in std::mem::take(&mut d.events) {
             match e {
                 Event::Frame(f) => {
@@ -174,7 +174,7 @@ impl Responder {
 
     fn answer(&self, d: &ModemDriver, m: &MacData) -> Command {
         let m_sdu = if m.m_sdu.first() == Some(&b'?') {
-            let phase = d.modem.mib().byte(0x000E, 8);
+            let phase = d.port.modem.mib().byte(0x000E, 8);
             format!("!{:03X} phase {phase}", self.address).into_bytes()
         } else {
             m.m_sdu.clone()
