@@ -67,17 +67,24 @@ pub fn write_resets(o: &Object) -> bool {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Store {
     values: Vec<(u16, Vec<u8>)>,
+    /// What 00A1h and 0000h say ([`Store::context`]), read again when
+    /// either is written: the modem asks for its layer and mode at every
+    /// look at its deadlines.
+    context: Context,
 }
 
 impl Default for Store {
     /// Every object at its factory default.
     fn default() -> Self {
-        Store {
+        let mut store = Store {
             values: OBJECTS
                 .iter()
                 .map(|o| (o.index, o.default.to_vec()))
                 .collect(),
-        }
+            context: Context::default(),
+        };
+        store.read_context();
+        store
     }
 }
 
@@ -103,14 +110,21 @@ impl Store {
             v.clear();
             v.extend_from_slice(value);
         }
+        if matches!(index, index::PLC_CONFIGURATION | index::FIMA_LIMA) {
+            self.read_context();
+        }
     }
 
     /// What decides availability and mode checks (00A1h, 0000h).
     pub fn context(&self) -> Context {
-        Context::from_mib(
+        self.context
+    }
+
+    fn read_context(&mut self) {
+        self.context = Context::from_mib(
             self.get(index::PLC_CONFIGURATION).unwrap_or_default(),
             self.get(index::FIMA_LIMA).unwrap_or_default(),
-        )
+        );
     }
 
     /// 00A1h.
@@ -188,6 +202,7 @@ impl Store {
         ] {
             f.set(v, f.get(&fresh).unwrap_or(0));
         }
+        self.read_context();
     }
 
     /// Adds `n` to a 4-byte LSByte-first counter (wrapping like the chip's
@@ -228,6 +243,39 @@ impl Store {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use plm_core::st7570::Layer;
+
+    /// The context kept is the one the MIB says after every kind of write
+    /// (a whole value, 0082h's gain into 00A1h, a reset).
+    #[test]
+    fn the_context_follows_the_mib() {
+        let said = |s: &Store| {
+            Context::from_mib(
+                s.get(index::PLC_CONFIGURATION).unwrap(),
+                s.get(index::FIMA_LIMA).unwrap(),
+            )
+        };
+        let mut s = Store::default();
+        assert_eq!(s.context(), said(&s));
+        let mut plc = s.plc();
+        plc.operating_mode = 2;
+        plc.access_layer_mode = Layer::Mac.access_layer_mode();
+        let o = mib::object(index::PLC_CONFIGURATION).unwrap();
+        s.write(o, &plc.encode());
+        assert_eq!((s.context().mode, s.context().layer), (2, Layer::Mac));
+        s.write(
+            mib::object(index::FIMA_LIMA).unwrap(),
+            &[0x01, 0x0C, 0x02, 0x0D],
+        );
+        assert_eq!((s.context().fima, s.context().lima), (0x0C01, 0x0D02));
+        s.write(mib::object(TX_GAIN).unwrap(), &[1, 7]);
+        assert_eq!(s.context(), said(&s));
+        let kept = s.after_reset(true);
+        assert_eq!(kept.context(), said(&kept));
+        assert_eq!(kept.context().mode, 2);
+        let fresh = s.after_reset(false);
+        assert_eq!(fresh.context(), Context::default());
+    }
 
     #[test]
     fn every_restored_object_exists_and_counters_are_not_restored() {
