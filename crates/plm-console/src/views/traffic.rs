@@ -68,12 +68,13 @@ pub fn TrafficView(tab: RwSignal<String>) -> impl IntoView {
             };
             draw_rows("traffic-table", all.len(), top, follow, &mut html, drawn)
         });
+        // Scrolled now, with the rows just drawn: the layout this forces
+        // falls at the quiet moment the session handed its notes out at,
+        // not at the next frame, when a modem frame may be ending.
         if follow {
-            request_animation_frame(|| {
-                if let Some(wrap) = document().get_element_by_id("traffic-wrap") {
-                    wrap.scroll_to_with_x_and_y(0.0, 1e9);
-                }
-            });
+            if let Some(wrap) = document().get_element_by_id("traffic-wrap") {
+                wrap.scroll_to_with_x_and_y(0.0, 1e9);
+            }
         }
         drawn
     });
