@@ -16,11 +16,12 @@ use crate::transport::{LinkState, Transport};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::energy::Meter;
 use plm_core::app::hid::{self, Hid, LampState};
+use plm_core::app::job::{Begun, Job, Run};
 use plm_core::app::service::{Clock, Discovered, Service};
 use plm_core::app::sweep::{Known, Reading, Round, RoundConfig};
 use plm_core::app::{
-    Address, AppEvent, Ballast, Concentrator, Discovery, Happening, Message, Request, RequestId,
-    RequesterConfig,
+    Address, AppEvent, AppFrame, Ballast, Concentrator, Discovery, Happening, Message, Request,
+    RequestId, RequesterConfig,
 };
 use plm_core::decode::{Decoded, Decoder};
 use plm_core::link::host;
@@ -119,12 +120,51 @@ pub type StreetReply = Box<dyn FnOnce(Result<Message, String>)>;
 enum Purpose {
     /// Read every parameter.
     Read(Address),
-    /// A unicast request of the sweep's round.
-    Round,
     Dim(Address, u8),
     View(StreetReply),
     /// A request of the update campaign (`true`: a broadcast).
     Update(bool),
+}
+
+/// The job that has the street's line: a discovery or the sweep's round
+/// (never both), its requests and what boards send routed by plm-core's
+/// [`Run`], as `plm board`'s and plm-sim's street's jobs are.
+enum StreetJob {
+    Discovery(Begun<Discovery>),
+    Round(Round),
+}
+
+impl StreetJob {
+    fn get(&self) -> &dyn Job {
+        match self {
+            StreetJob::Discovery(d) => d,
+            StreetJob::Round(r) => r,
+        }
+    }
+    fn get_mut(&mut self) -> &mut dyn Job {
+        match self {
+            StreetJob::Discovery(d) => d,
+            StreetJob::Round(r) => r,
+        }
+    }
+}
+
+impl Job for StreetJob {
+    fn poll(&mut self, now: Instant) -> Option<Request> {
+        self.get_mut().poll(now)
+    }
+    fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>) {
+        self.get_mut().on_answer(now, answer)
+    }
+    fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
+        self.get_mut().hear(address, message)
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        self.get().poll_timeout()
+    }
+    fn is_done(&self) -> bool {
+        self.get().is_done()
+    }
 }
 
 /// What a tick produced.
@@ -158,7 +198,8 @@ pub struct StreetSession {
     /// The transport, the page's clock on it, the ACK latency, the work.
     drive: Driver,
     conc: Concentrator,
-    discovery: Option<Discovery>,
+    /// The discovery or the sweep's round under way.
+    job: Option<Run<StreetJob>>,
     /// Boards the discovery had found when its current frame began (its
     /// belief of those left is updated at the end of each frame).
     found_before_frame: usize,
@@ -167,14 +208,10 @@ pub struct StreetSession {
     /// new ones.
     look_for_new: bool,
     sweep: Sweep,
-    /// The sweep's round under way (plm-core's reads of the street).
-    round: Option<Round>,
     next_sweep: Option<Instant>,
     fleet: BTreeMap<Address, Lamp>,
-    /// Requests that wait for the round's slots to close, or for the
-    /// page to draw the street's views ([`StreetSession::send_next`]);
-    /// a broadcast of the discovery or the sweep has no purpose.
-    held: Vec<(Request, Option<Purpose>)>,
+    /// The views' requests that wait for the round's slots to close.
+    held: Vec<(Request, Purpose)>,
     /// What each request under way is for (a few at a time: a list).
     purposes: Vec<(RequestId, Purpose)>,
     /// Names the modem's host-interface traffic (bare modem profile).
@@ -196,12 +233,11 @@ impl StreetSession {
         StreetSession {
             drive: Driver::new(Some(transport)),
             conc,
-            discovery: None,
+            job: None,
             found_before_frame: 0,
             session_no: 0,
             look_for_new: false,
             sweep: Sweep::default(),
-            round: None,
             next_sweep: None,
             fleet: BTreeMap::new(),
             held: Vec::new(),
@@ -281,7 +317,7 @@ impl StreetSession {
     /// many it believes are left (less those heard since its belief was
     /// last updated).
     pub fn discovering(&self) -> Option<(usize, usize)> {
-        self.discovery.as_ref().map(|d| {
+        self.discovery().map(|d| {
             let found = d.found().len();
             let heard = found.saturating_sub(self.found_before_frame);
             (found, (d.left() - heard as f64 + 0.5).max(0.0) as usize)
@@ -298,13 +334,13 @@ impl StreetSession {
         let now = self.now();
         self.session_no = self.session_no.wrapping_add(1);
         self.look_for_new = false;
-        self.round = None;
         let expected = self.fleet.len().max(12);
         let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, expected));
-        self.discovery = Some(d);
+        let job = StreetJob::Discovery(Begun::new(d, Some(first)));
+        self.job = Some(Run::new(job));
         self.found_before_frame = 0;
         self.out.found = true;
-        self.conc.submit(now, first);
+        self.run_discovery(now);
         let now = self.now();
         driver::flush(self, now);
     }
@@ -356,21 +392,24 @@ impl StreetSession {
         let config = DiscoveryConfig::new(self.session_no, 1);
         self.found_before_frame = known.len();
         let (d, first) = Discovery::resume(now, config, known);
-        self.discovery = Some(d);
+        let job = StreetJob::Discovery(Begun::new(d, Some(first)));
+        self.job = Some(Run::new(job));
         self.out.changed = true;
         // Remembered again: the connection was used last.
         self.out.found = true;
-        self.conc.submit(now, first);
+        self.run_discovery(now);
     }
 
     /// Turns the background sweep on or off.
     pub fn set_sweep(&mut self, on: bool) {
         self.sweep.on = on;
-        if on && self.round.is_none() {
+        if on && self.round().is_none() {
             self.next_sweep = Some(self.now());
         }
+        if !on && self.round().is_some() {
+            self.job = None;
+        }
         if !on {
-            self.round = None;
             self.sweep.total = 0;
             self.next_sweep = None;
         }
@@ -422,7 +461,7 @@ impl StreetSession {
         let now = self.now();
         // Lamps answer in their slots: a frame sent now would collide.
         if self.slots_open(now) {
-            self.held.push((request, Some(purpose)));
+            self.held.push((request, purpose));
             return;
         }
         let id = self.conc.submit(now, request);
@@ -431,38 +470,29 @@ impl StreetSession {
         driver::flush(self, now);
     }
 
-    /// Sends the discovery's or the sweep's next request (`purpose` none:
-    /// a broadcast, whose fate no one waits for), unless the street's
-    /// views are due to be drawn through a bare modem: the line is quiet
-    /// now (the last request's fate known, no window open), so the tick
-    /// stops, the page draws and lays the views out (`Console::tick`),
-    /// and the next tick sends it. A draw while the modem's frames may
-    /// end would hold up their ACKs (T_ACK, UM0932 3.2.8). Through a
+    /// Whether the discovery's or the sweep's next request is to wait for
+    /// the street's views to be drawn: through a bare modem, when they are
+    /// due, the line is quiet now (the last request's fate known, no
+    /// window open), so the tick stops, the page draws and lays the views
+    /// out (`Console::tick`), and the next tick sends it
+    /// ([`StreetSession::hold_for_draw`]). A draw while the modem's frames
+    /// may end would hold up their ACKs (T_ACK, UM0932 3.2.8). Through a
     /// board, the board ACKs its modem: nothing waits.
-    fn send_next(&mut self, now: Instant, q: Request, purpose: Option<Purpose>) {
-        let page = self.drive.tick_at();
+    fn draw_first(&self) -> bool {
         let changed = self.out.changed || self.out.sent > 0;
-        if self.via_modem() && self.shown.due(changed, page) {
-            self.out.show = self.shown.show_after(true, page, 0.0);
-            self.hold = true;
-            self.held.push((q, purpose));
-            return;
-        }
-        self.send(now, q, purpose);
+        self.via_modem() && self.shown.due(changed, self.drive.tick_at())
     }
 
-    fn send(&mut self, now: Instant, q: Request, purpose: Option<Purpose>) {
-        match purpose {
-            Some(p) => self.submit(q, p),
-            None => {
-                self.conc.submit(now, q);
-            }
-        }
+    /// The job's request was held back ([`StreetSession::draw_first`]):
+    /// the views are drawn now, and the tick stops for it.
+    fn hold_for_draw(&mut self) {
+        self.out.show = self.shown.show_after(true, self.drive.tick_at(), 0.0);
+        self.hold = true;
     }
 
     /// Whether the round's lamps (or new boards) may be answering now.
     fn slots_open(&self, now: Instant) -> bool {
-        let window = self.round.as_ref().and_then(|r| r.poll_timeout());
+        let window = self.round().and_then(|r| r.poll_timeout());
         window.is_some_and(|t| t > now)
     }
 
@@ -470,7 +500,7 @@ impl StreetSession {
     fn release_held(&mut self, now: Instant) {
         if !self.slots_open(now) && !self.hold {
             for (request, purpose) in std::mem::take(&mut self.held) {
-                self.send(now, request, purpose);
+                self.submit(request, purpose);
             }
         }
     }
@@ -486,7 +516,7 @@ impl StreetSession {
     /// line, at its quiet moments ([`StreetSession::send_next`]) or after
     /// [`STREET_DRAW_LATE_US`]; else at most every [`STREET_DRAW_US`].
     pub fn hand_out(&mut self, page_us: f64) -> StreetTick {
-        let busy = self.via_modem() && (self.discovery.is_some() || self.round.is_some());
+        let busy = self.via_modem() && self.job.is_some();
         let after = if busy {
             STREET_DRAW_LATE_US
         } else {
@@ -541,8 +571,7 @@ impl StreetSession {
     pub fn next_due(&self) -> Option<Instant> {
         earliest([
             self.conc.poll_timeout(),
-            self.discovery.as_ref().and_then(|d| d.poll_timeout()),
-            self.round.as_ref().and_then(|r| r.poll_timeout()),
+            self.job.as_ref().and_then(|j| j.poll_timeout()),
             self.next_sweep,
             (!self.held.is_empty() && !self.slots_open(self.now())).then(|| self.now()),
             self.update_timeout(),
@@ -555,19 +584,52 @@ impl StreetSession {
         self.next_due().and_then(|t| self.drive.pacer.page_at(t))
     }
 
+    /// The discovery under way.
+    fn discovery(&self) -> Option<&Discovery> {
+        match self.job.as_ref()?.job() {
+            StreetJob::Discovery(d) => Some(&d.job),
+            StreetJob::Round(_) => None,
+        }
+    }
+
+    /// The sweep's round under way (plm-core's reads of the street).
+    fn round(&self) -> Option<&Round> {
+        match self.job.as_ref()?.job() {
+            StreetJob::Round(r) => Some(r),
+            StreetJob::Discovery(_) => None,
+        }
+    }
+
+    /// Sends the job's next request, unless the views are to be drawn
+    /// first ([`StreetSession::draw_first`]); returns whether one was sent,
+    /// and the job once it is over.
+    fn pump_job(&mut self, now: Instant) -> (bool, Option<StreetJob>) {
+        let hold = self.draw_first();
+        let Some(run) = self.job.as_mut() else {
+            return (false, None);
+        };
+        let sent = run.pump_unless(&mut self.conc, now, hold).is_some();
+        if run.is_held() {
+            self.hold_for_draw();
+        } else if run.is_done() {
+            return (sent, self.job.take().map(Run::into_job));
+        }
+        (sent, None)
+    }
+
     fn run_discovery(&mut self, now: Instant) {
-        let Some(d) = self.discovery.as_mut().filter(|_| self.held.is_empty()) else {
+        let Some(found) = self.discovery().map(|d| d.found().len()) else {
             return;
         };
-        let next = d.handle_timeout(now);
-        let (found, done) = (d.found().len(), d.is_done());
-        if let Some(next) = next {
+        if !self.held.is_empty() {
+            return;
+        }
+        let (sent, done) = self.pump_job(now);
+        if sent {
             self.found_before_frame = found;
             self.out.changed = true;
-            self.send_next(now, next, None);
         }
-        if done {
-            self.discovery = None;
+        if done.is_some() {
             self.out.changed = true;
             // A street just found is read at once.
             self.next_sweep = Some(now);
@@ -579,7 +641,7 @@ impl StreetSession {
     /// asked through a board only (through a bare modem every frame heard
     /// carries it), and the probe for new boards unless a discovery looks
     /// for them after this round (docs/console.md, "Street").
-    fn round(&self) -> Round {
+    fn new_round(&self) -> Round {
         let lamps = self
             .fleet
             .values()
@@ -603,12 +665,12 @@ impl StreetSession {
     fn run_sweep(&mut self, now: Instant) {
         // A firmware update has the line to itself.
         let updating = self.campaign.as_ref().is_some_and(|c| !c.update.is_done());
-        if !self.sweep.on || self.discovery.is_some() || updating {
+        if !self.sweep.on || self.discovery().is_some() || updating {
             return;
         }
-        if self.round.is_none() && self.next_sweep.is_some_and(|t| t <= now) {
+        if self.job.is_none() && self.next_sweep.is_some_and(|t| t <= now) {
             self.next_sweep = None;
-            self.round = Some(self.round());
+            self.job = Some(Run::new(StreetJob::Round(self.new_round())));
             self.sweep.total = self.fleet.len();
             self.sweep.done = 0;
             self.out.changed = true;
@@ -617,35 +679,26 @@ impl StreetSession {
         if self.conc.requester().pending() > 0 || !self.held.is_empty() {
             return;
         }
-        let Some(round) = self.round.as_mut() else {
-            return;
-        };
-        match round.poll(now) {
-            Some(q) if q.broadcast => self.send_next(now, q, None),
-            Some(q) => self.send_next(now, q, Some(Purpose::Round)),
-            None if round.is_done() => {
-                let new = round.found_new();
-                self.round = None;
-                self.sweep.rounds += 1;
-                self.sweep.total = 0;
-                // Sooner when a dimming of every lamp asked for it.
-                let pause = now + SWEEP_PAUSE;
-                self.next_sweep = Some(self.next_sweep.map_or(pause, |t| t.min(pause)));
-                self.out.changed = true;
-                // A probe heard a new board: a discovery names it and
-                // looks for more.
-                if self.look_for_new || new {
-                    self.look_for_new(now);
-                }
+        if let (_, Some(StreetJob::Round(round))) = self.pump_job(now) {
+            let new = round.found_new();
+            self.sweep.rounds += 1;
+            self.sweep.total = 0;
+            // Sooner when a dimming of every lamp asked for it.
+            let pause = now + SWEEP_PAUSE;
+            self.next_sweep = Some(self.next_sweep.map_or(pause, |t| t.min(pause)));
+            self.out.changed = true;
+            // A probe heard a new board: a discovery names it and looks
+            // for more.
+            if self.look_for_new || new {
+                self.look_for_new(now);
             }
-            None => {}
         }
     }
 
     /// What the round learned, into the fleet.
     fn take_readings(&mut self, now: Instant) {
         let modem = self.via_modem();
-        let Some(round) = self.round.as_mut() else {
+        let Some(StreetJob::Round(round)) = self.job.as_mut().map(Run::job_mut) else {
             return;
         };
         let readings = round.take_readings();
@@ -685,8 +738,11 @@ impl StreetSession {
     }
 
     fn on_happening(&mut self, now: Instant, h: Happening) {
+        // The job's first: it hears a board's frame (its answer is sent)
+        // and takes its request's fate.
+        let job = (self.job.as_mut()).is_some_and(|run| run.handle(&mut self.conc, now, &h));
         match h {
-            Happening::App(e) => self.on_app(now, e),
+            Happening::App(e) => self.on_app(now, e, job),
             Happening::Heard { address, snr } => {
                 if let Some(l) = self.fleet.get_mut(&address).filter(|_| snr.is_some()) {
                     l.snr = snr;
@@ -721,25 +777,17 @@ impl StreetSession {
         })
     }
 
-    fn on_app(&mut self, now: Instant, e: AppEvent) {
+    /// What an application event means for the fleet and the views'
+    /// requests; `job`: the discovery's or the round's, which its [`Run`]
+    /// has had.
+    fn on_app(&mut self, now: Instant, e: AppEvent, job: bool) {
+        let sent = matches!(e, AppEvent::Sent { .. });
         match e {
             AppEvent::Unsolicited {
-                address, message, ..
-            } => {
-                if let Some(d) = self.discovery.as_mut() {
-                    if let Some(ack) = d.on_message(address, &message) {
-                        self.conc.send(now, ack);
-                    }
-                    if let Message::Service(Service::DiscoverReply(r)) = message {
-                        self.discovered(now, address, r);
-                    }
-                } else if let Some(round) = self.round.as_mut() {
-                    if let Some(ack) = round.hear(address, &message) {
-                        self.conc.send(now, ack);
-                    }
-                    self.take_readings(now);
-                }
-            }
+                address,
+                message: Message::Service(Service::DiscoverReply(r)),
+                ..
+            } if job && self.discovery().is_some() => self.discovered(now, address, r),
             AppEvent::Answered {
                 id,
                 address,
@@ -757,11 +805,12 @@ impl StreetSession {
                 address,
                 reason,
             } => {
-                if let Some(p) = self.purpose(id) {
-                    let unicast = !matches!(p, Purpose::View(_)) || address != Address::BROADCAST;
-                    if unicast && self.fleet.contains_key(&address) {
-                        self.unreachable(now, address, &reason);
-                    }
+                let p = self.purpose(id);
+                let unicast = !matches!(p, Some(Purpose::View(_))) || address != Address::BROADCAST;
+                if (job || p.is_some()) && unicast && self.fleet.contains_key(&address) {
+                    self.unreachable(now, address, &reason);
+                }
+                if let Some(p) = p {
                     self.fulfil(now, p, Err(reason));
                 }
             }
@@ -770,7 +819,10 @@ impl StreetSession {
                     self.fulfil(now, p, Ok(Message::Ping));
                 }
             }
-            AppEvent::Retry { .. } | AppEvent::Malformed { .. } => {}
+            _ => {}
+        }
+        if job && !sent {
+            self.take_readings(now);
         }
     }
 
@@ -844,12 +896,6 @@ impl StreetSession {
         match (p, r) {
             (Purpose::Read(a), Ok(Message::Hid(Hid::Reply { value, .. }))) => {
                 self.ballast(now, a, &value);
-            }
-            (Purpose::Round, r) => {
-                if let Some(round) = self.round.as_mut() {
-                    round.on_answer(r);
-                    self.take_readings(now);
-                }
             }
             (Purpose::Dim(a, level), Ok(Message::Ack { .. })) => {
                 self.lamp(a).dimming = Some(level);
@@ -946,9 +992,11 @@ mod tests {
     /// A street of 50: discovery, the sweep reading every lamp, dimming
     /// one and all (broadcast), every clock set, a failed lamp and an
     /// unreachable one raised as alerts: through the board's USART and
-    /// through a bare modem.
+    /// through a bare modem. The discovery and the sweep's rounds are
+    /// plm-core's jobs run by plm-core's `job::Run`, the code `plm board
+    /// discover` and plm-sim's `StreetDriver` run them with.
     #[test]
-    fn a_street_is_found_read_dimmed_and_watched() {
+    fn a_street_is_found_read_dimmed_and_watched_by_plm_cores_run() {
         for via in [Attach::Board, Attach::Modem] {
             let mut s = session(via);
             s.discover();

@@ -231,8 +231,8 @@ impl Job for Noting<'_> {
         }
         r
     }
-    fn on_answer(&mut self, now: plm_core::time::Instant, answer: Result<Message, String>) {
-        self.update.on_answer(now, answer)
+    fn on_answer(&mut self, now: plm_core::time::Instant, answer: Result<&Message, &str>) {
+        Job::on_answer(&mut *self.update, now, answer)
     }
     fn hear(&mut self, a: Address, m: &Message) -> Option<plm_core::app::AppFrame> {
         Job::hear(&mut *self.update, a, m)

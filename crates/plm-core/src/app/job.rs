@@ -24,8 +24,9 @@ pub trait Job {
     /// one's fate is known).
     fn poll(&mut self, now: Instant) -> Option<Request>;
     /// The fate of the last request that expected an answer: the answer,
-    /// or why there is none.
-    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>);
+    /// or why there is none (lent: the happening stays whole for the
+    /// driver).
+    fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>);
     /// A frame that came unasked; the frame to send back, if any.
     fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame>;
     /// When [`Job::poll`] is due for time.
@@ -39,7 +40,7 @@ impl<J: Job + ?Sized> Job for &mut J {
     fn poll(&mut self, now: Instant) -> Option<Request> {
         (**self).poll(now)
     }
-    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
+    fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>) {
         (**self).on_answer(now, answer)
     }
     fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
@@ -73,7 +74,7 @@ impl<J: Job> Job for Begun<J> {
     fn poll(&mut self, now: Instant) -> Option<Request> {
         self.first.take().or_else(|| self.job.poll(now))
     }
-    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
+    fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>) {
         self.job.on_answer(now, answer)
     }
     fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
@@ -95,7 +96,7 @@ macro_rules! broadcasts {
             fn poll(&mut self, now: Instant) -> Option<Request> {
                 self.handle_timeout(now)
             }
-            fn on_answer(&mut self, _: Instant, _: Result<Message, String>) {}
+            fn on_answer(&mut self, _: Instant, _: Result<&Message, &str>) {}
             fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
                 $hear(self, address, message)
             }
@@ -121,7 +122,7 @@ impl Job for Round {
     fn poll(&mut self, now: Instant) -> Option<Request> {
         Round::poll(self, now)
     }
-    fn on_answer(&mut self, _: Instant, answer: Result<Message, String>) {
+    fn on_answer(&mut self, _: Instant, answer: Result<&Message, &str>) {
         Round::on_answer(self, answer)
     }
     fn hear(&mut self, address: Address, message: &Message) -> Option<AppFrame> {
@@ -139,8 +140,8 @@ impl Job for Update {
     fn poll(&mut self, now: Instant) -> Option<Request> {
         Update::poll(self, now)
     }
-    fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
-        Update::on_answer(self, now, answer)
+    fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>) {
+        Update::on_answer(self, now, answer.cloned().map_err(String::from))
     }
     fn hear(&mut self, _: Address, _: &Message) -> Option<AppFrame> {
         None
@@ -176,8 +177,8 @@ impl Job for Ask {
     fn poll(&mut self, _: Instant) -> Option<Request> {
         self.request.take()
     }
-    fn on_answer(&mut self, _: Instant, answer: Result<Message, String>) {
-        self.answer = Some(answer);
+    fn on_answer(&mut self, _: Instant, answer: Result<&Message, &str>) {
+        self.answer = Some(answer.cloned().map_err(String::from));
     }
     fn hear(&mut self, _: Address, _: &Message) -> Option<AppFrame> {
         None
@@ -196,6 +197,8 @@ pub struct Run<J> {
     job: J,
     /// The job's request whose fate is awaited.
     awaiting: Option<RequestId>,
+    /// The job's next request, held back by its driver ([`Run::pump_unless`]).
+    held: Option<Request>,
 }
 
 impl<J: Job> Run<J> {
@@ -204,6 +207,7 @@ impl<J: Job> Run<J> {
         Run {
             job,
             awaiting: None,
+            held: None,
         }
     }
 
@@ -225,13 +229,40 @@ impl<J: Job> Run<J> {
     /// Submits the job's next request, if one is due now and the last
     /// one's fate is known. Returns its id.
     pub fn pump(&mut self, conc: &mut Concentrator, now: Instant) -> Option<RequestId> {
+        self.pump_unless(conc, now, false)
+    }
+
+    /// [`Run::pump`], unless `hold`: then the job's next request, if it
+    /// has one, waits for a later pump ([`Run::is_held`]); the console
+    /// holds it while the page draws, so that no redraw sits between a
+    /// modem frame and its ACK.
+    pub fn pump_unless(
+        &mut self,
+        conc: &mut Concentrator,
+        now: Instant,
+        hold: bool,
+    ) -> Option<RequestId> {
         if self.awaiting.is_some() {
             return None;
         }
-        let request = self.job.poll(now)?;
+        let request = self.held.take().or_else(|| self.job.poll(now))?;
+        if hold {
+            self.held = Some(request);
+            return None;
+        }
         let id = conc.submit(now, request);
         self.awaiting = Some(id);
         Some(id)
+    }
+
+    /// Whether the job's next request is held back ([`Run::pump_unless`]).
+    pub fn is_held(&self) -> bool {
+        self.held.is_some()
+    }
+
+    /// Whether the job's request under way is `id`.
+    pub fn awaits(&self, id: RequestId) -> bool {
+        self.awaiting == Some(id)
     }
 
     /// A happening of the concentrator: the fate of the job's request, or
@@ -255,23 +286,26 @@ impl<J: Job> Run<J> {
         }
         self.awaiting = None;
         match e {
-            AppEvent::Answered { answer, .. } => self.job.on_answer(now, Ok(answer.clone())),
-            AppEvent::Failed { reason, .. } => self.job.on_answer(now, Err(reason.clone())),
+            AppEvent::Answered { answer, .. } => self.job.on_answer(now, Ok(answer)),
+            AppEvent::Failed { reason, .. } => self.job.on_answer(now, Err(reason)),
             // Sent, and no answer expected.
             _ => {}
         }
         true
     }
 
-    /// When [`Run::pump`] is due for time.
+    /// When [`Run::pump`] is due for time (a request held back: at once).
     pub fn poll_timeout(&self) -> Option<Instant> {
-        self.awaiting
-            .map_or_else(|| self.job.poll_timeout(), |_| None)
+        match (self.awaiting, &self.held) {
+            (Some(_), _) => None,
+            (None, Some(_)) => Some(0),
+            (None, None) => self.job.poll_timeout(),
+        }
     }
 
     /// Whether the job is over, its last request's fate known.
     pub fn is_done(&self) -> bool {
-        self.awaiting.is_none() && self.job.is_done()
+        self.awaiting.is_none() && self.held.is_none() && self.job.is_done()
     }
 }
 

@@ -277,15 +277,15 @@ impl Round {
 
     /// The fate of the unicast request under way: its answer, or why
     /// there is none.
-    pub fn on_answer(&mut self, answer: Result<Message, String>) {
+    pub fn on_answer(&mut self, answer: Result<&Message, &str>) {
         let Some((a, ask)) = self.asked.take() else {
             return;
         };
         let reading = match (ask, answer) {
             (Ask::Read, Ok(Message::Hid(Hid::Reply { param, value })))
-                if param == self.config.read.param =>
+                if *param == self.config.read.param =>
             {
-                Reading::Value(a, value)
+                Reading::Value(a, value.clone())
             }
             (Ask::Read, Ok(Message::Error(code))) => {
                 Reading::Failed(a, format!("the board answered with an error: {code}"))
@@ -293,8 +293,8 @@ impl Round {
             (Ask::Read, Ok(other)) => {
                 Reading::Failed(a, format!("an unexpected answer: {}", other.name()))
             }
-            (Ask::Read, Err(why)) => Reading::Failed(a, why),
-            (Ask::Snr, Ok(Message::Service(Service::Sn(v)))) => Reading::Snr(a, v),
+            (Ask::Read, Err(why)) => Reading::Failed(a, why.into()),
+            (Ask::Snr, Ok(Message::Service(Service::Sn(v)))) => Reading::Snr(a, *v),
             (Ask::Snr, _) => return,
         };
         if let Reading::Failed(..) = reading {
@@ -433,10 +433,10 @@ mod tests {
         // The stragglers, alone, one after the other.
         assert_eq!(q, Request::to(board(7), Message::Hid(Hid::Get(hid::ALL))));
         assert_eq!(r.poll(t), None, "one at a time");
-        r.on_answer(Err("did not answer".into()));
+        r.on_answer(Err("did not answer"));
         let q = r.poll(t).expect("the next straggler");
         assert_eq!(q, Request::to(board(33), Message::Hid(Hid::Get(hid::ALL))));
-        r.on_answer(Ok(reply(33)));
+        r.on_answer(Ok(&reply(33)));
         assert_eq!(
             readings(&mut r),
             [
@@ -452,10 +452,11 @@ mod tests {
         let mut q = r.poll(t).expect("an SNR request");
         while let Message::Service(Service::SnGet) = q.message {
             snr.push(q.address);
+            let sn = Message::Service(Service::Sn(q.address.0[5]));
             r.on_answer(match q.address == board(22) {
                 // A board that does not answer its SNR: nothing learned.
-                true => Err("did not answer".into()),
-                false => Ok(Message::Service(Service::Sn(q.address.0[5]))),
+                true => Err("did not answer"),
+                false => Ok(&sn),
             });
             q = r.poll(t).expect("a request");
         }
@@ -497,10 +498,10 @@ mod tests {
         let mut r = Round::new(lamps, RoundConfig::READS);
         let q = r.poll(0).expect("a request");
         assert_eq!(q, Request::to(board(1), Message::Hid(Hid::Get(hid::ALL))));
-        r.on_answer(Ok(Message::Error(ErrorCode(0x12))));
+        r.on_answer(Ok(&Message::Error(ErrorCode(0x12))));
         let q = r.poll(0).expect("a request");
         assert_eq!(q.address, board(2));
-        r.on_answer(Ok(Message::Ping));
+        r.on_answer(Ok(&Message::Ping));
         assert_eq!(r.poll(0), None);
         assert!(r.is_done());
         let got = readings(&mut r);
