@@ -260,11 +260,6 @@ impl<J: Job> Run<J> {
         self.held.is_some()
     }
 
-    /// Whether the job's request under way is `id`.
-    pub fn awaits(&self, id: RequestId) -> bool {
-        self.awaiting == Some(id)
-    }
-
     /// A happening of the concentrator: the fate of the job's request, or
     /// a frame a board sent unasked (the job's answer to it is sent).
     /// Returns whether it was the job's.
@@ -374,4 +369,35 @@ pub fn fate<I: Io + ?Sized>(
         }
     }
     Ok((id, None))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::requester::RequesterConfig;
+
+    /// A request held back by its driver waits, is due at once, keeps the
+    /// job from being over, and goes at the next pump; its fate then
+    /// closes the job.
+    #[test]
+    fn a_held_request_goes_at_the_next_pump() {
+        let mut conc = Concentrator::usart(RequesterConfig::default());
+        let mut run = Run::new(Ask::new(Request::all(Message::Ping)));
+        assert_eq!(run.pump_unless(&mut conc, 0, true), None);
+        assert!(run.is_held() && !run.is_done());
+        assert_eq!(run.poll_timeout(), Some(0));
+        assert!(conc.poll_happening().is_none(), "nothing sent");
+        let id = run.pump_unless(&mut conc, 5, false).expect("sent now");
+        assert!(!run.is_held() && !run.is_done());
+        assert_eq!(run.poll_timeout(), None, "its fate awaited");
+        let mut fates = 0;
+        while let Some(h) = conc.poll_happening() {
+            if matches!(&h, Happening::App(e) if e.fate_of() == Some(id)) {
+                fates += 1;
+                assert!(run.handle(&mut conc, 5, &h));
+            }
+        }
+        assert_eq!(fates, 1, "a broadcast is sent as it is queued");
+        assert!(run.is_done());
+    }
 }
