@@ -200,6 +200,15 @@ impl Driver {
         self.work
     }
 
+    /// When the page must run to its clock's resolution (µs of the
+    /// page's clock), for a host that ACKs the modem's frames (`acks`):
+    /// the bytes on the UART have arrived one way, and a frame may end
+    /// there ([`Transport::uart_due`]).
+    pub fn exact_wake(&self, acks: bool) -> Option<f64> {
+        let due = self.transport.as_ref()?.uart_due().filter(|_| acks)?;
+        self.pacer.page_at(due)
+    }
+
     /// The host engine wrote an ACK for the frame whose last byte came at
     /// `at`: one sample, on both clocks.
     fn acked(&mut self, at: Instant) {

@@ -185,13 +185,14 @@ pub struct Session {
     log_offset: i64,
     /// Requests in a row whose T_REQ went unanswered at least once.
     unanswered: u8,
-    /// When notes were last handed out, µs of the page's clock.
+    /// When notes were last handed out, or painted when the line waited
+    /// for that, µs of the page's clock.
     shown: f64,
     /// Elements on the wire among the notes not handed out yet.
     held: usize,
-    /// Notes were just handed out: the next request waits for the next
-    /// tick ([`Session::holds_line`]).
-    hold: bool,
+    /// Notes were handed out: the next request waits until the page has
+    /// painted them ([`Session::holds_line`]).
+    hold: crate::wake::Draw,
     /// The modem's timeouts (MIB 09h, 000Bh, the chip's at reset); the
     /// host engine waits them plus the transport's latency.
     timeouts: Timeouts,
@@ -216,7 +217,7 @@ impl Session {
             unanswered: 0,
             shown: 0.0,
             held: 0,
-            hold: false,
+            hold: Default::default(),
             timeouts: Timeouts::at_reset(dialect, baud),
             out: Tick::default(),
         };
@@ -361,7 +362,16 @@ impl Session {
     /// down, requests fail at once with its reason instead of waiting for
     /// the link's timeouts.
     pub fn tick(&mut self, page_us: f64, budget: Budget) -> Tick {
-        self.hold = false;
+        if self.hold.pending() {
+            self.hold.settle();
+            // The pace of the hand-outs counts from the paint, when the
+            // line goes on: else each wait for a frame would let the next
+            // hand-out fall due, one exchange later, and the line would
+            // wait for every frame.
+            if !self.hold.pending() {
+                self.shown = page_us;
+            }
+        }
         if self.outstanding() > 0 {
             if let LinkState::Disconnected(why) = self.state() {
                 self.fail_requests(&why);
@@ -389,7 +399,9 @@ impl Session {
             };
         }
         self.shown = page_us;
-        self.hold = !self.out.notes.is_empty();
+        if !self.out.notes.is_empty() {
+            self.hold.begin();
+        }
         self.take()
     }
 
@@ -400,23 +412,23 @@ impl Session {
     }
 
     /// Whether the next request waits: notes are due (they wait for the
-    /// answer on the line, [`Session::take_due`]), or were handed out
-    /// since the last tick ([`Session::drawing`]). The page
+    /// answer on the line, [`Session::take_due`]), or were handed out and
+    /// the page has not painted them yet ([`Session::drawing`]). The page
     /// redraws then while no frame of the modem can end: the modem answers
     /// requests, and the next has not left (issue 13: a redraw of the
     /// Traffic table, 5-8 ms, held up the ACKs of the frames that ended
-    /// under it: p99 9-10 ms, now 1-2 ms). Frames the modem sends of its
-    /// own accord still come when they come. It costs the line the page's
-    /// layout once per hand-out.
+    /// under it: p99 9-10 ms, then 1-2 ms; its paint at the next frame,
+    /// 2-4 ms, did too). Frames the modem sends of its own accord still
+    /// come when they come. It costs the line up to a frame (16.7 ms at
+    /// 60 Hz) once per hand-out.
     pub fn holds_line(&self) -> bool {
-        self.hold || (!self.out.notes.is_empty() && self.drive.tick_at() >= self.show_at())
+        self.hold.pending() || (!self.out.notes.is_empty() && self.drive.tick_at() >= self.show_at())
     }
 
-    /// Whether notes were handed out since the last tick: the line is
-    /// quiet, and the console has the page laid out before the
-    /// next tick lets the next request go (`Console::tick`).
+    /// Whether notes handed out wait to be painted: the line is quiet
+    /// until the page's next frame ([`crate::wake::Draw`]).
     pub fn drawing(&self) -> bool {
-        self.hold
+        self.hold.pending()
     }
 
     /// When the notes held back are handed out, µs of the page's clock:
@@ -459,6 +471,11 @@ impl Session {
         let notes = (!self.out.notes.is_empty()).then_some(self.show_at());
         let due = self.next_due().and_then(|t| self.drive.pacer.page_at(t));
         [notes, due].into_iter().flatten().reduce(f64::min)
+    }
+
+    /// [`Driver::exact_wake`].
+    pub fn exact_wake(&self) -> Option<f64> {
+        self.drive.exact_wake(true)
     }
 
     /// Hands the next queued request to the engine when none is

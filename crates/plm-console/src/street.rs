@@ -221,9 +221,9 @@ pub struct StreetSession {
     /// When the street's views were last drawn, and whether a change
     /// waits.
     shown: Throttle,
-    /// A draw was handed out at a quiet moment of the line: the page lays
-    /// the views out before the next tick sends anything.
-    hold: bool,
+    /// A draw was handed out at a quiet moment of the line: nothing is
+    /// sent until the page has painted it.
+    hold: crate::wake::Draw,
 }
 
 impl StreetSession {
@@ -246,7 +246,7 @@ impl StreetSession {
             out: StreetTick::default(),
             campaign: None,
             shown: Throttle::new(STREET_DRAW_US),
-            hold: false,
+            hold: Default::default(),
         }
     }
 
@@ -487,7 +487,7 @@ impl StreetSession {
     /// the views are drawn now, and the tick stops for it.
     fn hold_for_draw(&mut self) {
         self.out.show = self.shown.show_after(true, self.drive.tick_at(), 0.0);
-        self.hold = true;
+        self.hold.begin();
     }
 
     /// Whether the round's lamps (or new boards) may be answering now.
@@ -498,7 +498,7 @@ impl StreetSession {
 
     /// Sends what waited for the slots to close or the views' draw.
     fn release_held(&mut self, now: Instant) {
-        if !self.slots_open(now) && !self.hold {
+        if !self.slots_open(now) && !self.hold.pending() {
             for (request, purpose) in std::mem::take(&mut self.held) {
                 self.submit(request, purpose);
             }
@@ -534,15 +534,15 @@ impl StreetSession {
         tick
     }
 
-    /// Whether the last tick stopped for a draw: the page lays the views
-    /// out before the next tick.
+    /// Whether a draw handed out waits to be painted before anything is
+    /// sent.
     pub fn drawing(&self) -> bool {
-        self.hold
+        self.hold.pending()
     }
 
     /// Lets the transport's time catch up with the page's clock.
     pub fn tick(&mut self, page_us: f64, budget: Budget) -> StreetTick {
-        self.hold = false;
+        self.hold.settle();
         if let LinkState::Disconnected(why) = self.state() {
             if self.conc.requester().pending() > 0 {
                 self.conc.abort_all(&why);
@@ -559,7 +559,7 @@ impl StreetSession {
     pub fn run_until(&mut self, start: Instant, target: Instant) {
         let mut t = start;
         while t < target && self.drive.transport.is_some() {
-            self.hold = false;
+            self.hold.settle();
             driver::run_within(self, t, target, Budget::UNLIMITED);
             t = self.now();
         }
@@ -582,6 +582,11 @@ impl StreetSession {
     /// [`StreetSession::next_due`] on the page's clock (µs).
     pub fn next_wake(&self) -> Option<f64> {
         self.next_due().and_then(|t| self.drive.pacer.page_at(t))
+    }
+
+    /// [`Driver::exact_wake`].
+    pub fn exact_wake(&self) -> Option<f64> {
+        self.drive.exact_wake(self.acks())
     }
 
     /// The discovery under way.
@@ -940,7 +945,7 @@ impl Layer for StreetSession {
     /// Replies go to the views at the instant they came: a reply may send
     /// the next request.
     fn stop(&self) -> bool {
-        !self.out.replies.is_empty() || self.hold
+        !self.out.replies.is_empty() || self.hold.fresh()
     }
 }
 

@@ -12,40 +12,74 @@
 //! something is due, which costs nothing when nothing is.
 //!
 //! A timer waits whole milliseconds, and rounded up that made an ACK up to
-//! 1 ms late (issue 13: p50 0.5 ms). So a deadline closer than 2 ms (the
-//! next byte of a frame coming in) is waited by the timer's whole
-//! milliseconds rounded down, and its last fraction of one by messages,
-//! one after the page's other tasks. That loop only runs while a byte is
-//! due within the millisecond: with nothing due, the page sleeps on its
-//! timer.
+//! 1 ms late (issue 13: p50 0.5 ms). So the deadline at which the host
+//! must act at once ([`exactly`]: the last byte on the UART either way
+//! arrives, where a frame may end, to be ACKed or answered) is waited, when closer than 2 ms, by the timer's
+//! whole milliseconds rounded down and its last fraction of one by
+//! messages, one after the page's other tasks. Every other deadline (the
+//! world's next byte, the engine's timeouts, the idle wake) is waited by
+//! the timer rounded up: spinning on messages for every byte of a frame
+//! left so much garbage (45 MB in 300 reads) that the page collected it
+//! every few hundred ms, 3-8 ms each, in the middle of a modem's frame.
 //! Natively (the tests) there is no page: nothing is run.
 
 #[cfg(target_arch = "wasm32")]
 mod page {
     use crate::clock::page_now_us;
-    use gloo_timers::callback::Timeout;
     use std::cell::RefCell;
     use std::rc::Rc;
-    use wasm_bindgen::closure::Closure;
-    use wasm_bindgen::{JsCast, JsValue};
-    use web_sys::Window;
+    use wasm_bindgen::prelude::*;
+
+    // The page's own `postMessage` and timers, called straight: web-sys's
+    // wrap each call in a closure over its arguments to catch what cannot
+    // be thrown here, and pass the origin as a new string, and a timer
+    // each time made a closure of its own. Waiting a fraction of a
+    // millisecond posts a message every few µs, and that garbage (35 MB
+    // in 300 reads) had the page collect it every few hundred ms,
+    // 3-8 ms each, in the middle of a modem's frame.
+    #[wasm_bindgen]
+    extern "C" {
+        #[wasm_bindgen(js_name = postMessage)]
+        fn post_message(message: &JsValue, origin: &JsValue);
+        #[wasm_bindgen(js_name = setTimeout)]
+        fn set_timeout(run: &JsValue, ms: u32) -> f64;
+        #[wasm_bindgen(js_name = clearTimeout)]
+        fn clear_timeout(id: f64);
+        #[wasm_bindgen(js_name = addEventListener)]
+        fn add_event_listener(kind: &str, run: &JsValue);
+        #[wasm_bindgen(js_name = requestAnimationFrame)]
+        fn request_animation_frame(run: &JsValue) -> f64;
+    }
 
     struct Waker {
         run: Rc<dyn Fn()>,
         /// When to run next, µs of the page's clock (infinite: nothing due).
         due: f64,
+        /// Whether `due` is met to the clock's resolution ([`super::exactly`]).
+        exact: bool,
         /// A message is on its way.
         posted: bool,
-        /// The timer for a later deadline (dropped: cancelled).
-        timer: Option<Timeout>,
-        window: Window,
+        /// The timer for a later deadline.
+        timer: Option<f64>,
+        /// `postMessage`'s origin ("*"), made once.
+        origin: JsValue,
+        /// Frames painted since the page opened ([`super::Draw`]).
+        frames: u64,
+        /// When the next frame was asked for, while it has not come.
+        frame_asked: Option<f64>,
+        /// A frame is being painted: the next message comes after it.
+        painting: bool,
+        on_timer: Closure<dyn FnMut()>,
+        on_frame: Closure<dyn FnMut()>,
         _on_message: Closure<dyn FnMut()>,
     }
 
-    /// Deadlines closer than this (ms) are met to the page's clock's
-    /// resolution: a byte arriving, which may end a frame to ACK. Further
-    /// ones (the idle wake, the engine's timeouts) may be late by under a
-    /// millisecond, and the page does not spin for them.
+    /// How long a draw waits for the page's next frame (µs): a hidden or
+    /// throttled page paints none, and its line goes on.
+    const FRAME_WAIT_US: f64 = 50_000.0;
+
+    /// An exact deadline closer than this (ms) is met to the page's
+    /// clock's resolution; a further one is first waited by the timer.
     const PRECISE_MS: f64 = 2.0;
 
     thread_local! {
@@ -53,25 +87,75 @@ mod page {
     }
 
     pub fn install(run: Rc<dyn Fn()>) {
-        let Some(window) = web_sys::window() else {
-            return;
-        };
         let on_message = Closure::<dyn FnMut()>::new(|| {
-            with(|w| w.posted = false);
+            with(|w| {
+                w.posted = false;
+                // Tasks queued during a frame run once it is painted.
+                if std::mem::take(&mut w.painting) {
+                    w.frames += 1;
+                }
+            });
             arm();
         });
-        let _ =
-            window.add_event_listener_with_callback("message", on_message.as_ref().unchecked_ref());
+        add_event_listener("message", on_message.as_ref());
+        let on_timer = Closure::<dyn FnMut()>::new(|| {
+            with(|w| w.timer = None);
+            arm();
+        });
+        let on_frame = Closure::<dyn FnMut()>::new(|| {
+            with(|w| {
+                w.frame_asked = None;
+                w.painting = true;
+                w.posted = false;
+                w.post();
+            })
+        });
         WAKER.with(|w| {
             *w.borrow_mut() = Some(Waker {
                 run,
                 due: f64::INFINITY,
+                exact: false,
                 posted: false,
                 timer: None,
-                window,
+                origin: JsValue::from_str("*"),
+                frames: 0,
+                frame_asked: None,
+                painting: false,
+                on_timer,
+                on_frame,
                 _on_message: on_message,
             })
         });
+    }
+
+    /// Frames painted so far; a frame asked for that has not come within
+    /// [`FRAME_WAIT_US`] counts as painted.
+    pub fn frames() -> u64 {
+        let now = page_now_us();
+        with(|w| {
+            if w.frame_asked.is_some_and(|t| now - t > FRAME_WAIT_US) {
+                w.frame_asked = None;
+                w.frames += 1;
+            }
+            w.frames
+        })
+    }
+
+    /// Asks for the next frame, if not yet asked; the page runs once it
+    /// is painted, or after [`FRAME_WAIT_US`].
+    pub fn next_frame() {
+        let now = page_now_us();
+        let asked = with(|w| {
+            let ask = w.frame_asked.is_none() && !w.painting;
+            if ask {
+                w.frame_asked = Some(now);
+                request_animation_frame(w.on_frame.as_ref());
+            }
+            ask
+        });
+        if asked {
+            at(now + FRAME_WAIT_US, false);
+        }
     }
 
     fn with<R: Default>(f: impl FnOnce(&mut Waker) -> R) -> R {
@@ -88,7 +172,7 @@ mod page {
                 return Some(w.run.clone());
             }
             let left = (w.due - now) / 1_000.0;
-            let ms = if left < PRECISE_MS {
+            let ms = if w.exact && left < PRECISE_MS {
                 left.floor()
             } else {
                 left.ceil()
@@ -96,10 +180,7 @@ mod page {
             if ms < 1.0 {
                 w.post();
             } else if ms.is_finite() && w.timer.is_none() {
-                w.timer = Some(Timeout::new(ms as u32, || {
-                    with(|w| w.timer = None);
-                    arm();
-                }));
+                w.timer = Some(set_timeout(w.on_timer.as_ref(), ms as u32));
             }
             None
         });
@@ -108,13 +189,16 @@ mod page {
         }
     }
 
-    pub fn at(page_us: f64) {
+    pub fn at(page_us: f64, exact: bool) {
         with(|w| {
-            if page_us >= w.due {
+            if page_us > w.due || (page_us == w.due && !exact) {
                 return;
             }
             w.due = page_us;
-            w.timer = None;
+            w.exact = exact;
+            if let Some(id) = w.timer.take() {
+                clear_timeout(id);
+            }
             w.post();
         });
     }
@@ -123,7 +207,8 @@ mod page {
         /// Has the page look again once its tasks queued so far have run.
         fn post(&mut self) {
             if !self.posted {
-                self.posted = self.window.post_message(&JsValue::NULL, "*").is_ok();
+                post_message(&JsValue::NULL, &self.origin);
+                self.posted = true;
             }
         }
     }
@@ -137,16 +222,64 @@ pub fn install(run: impl Fn() + 'static) {
     let _ = run;
 }
 
-/// Has the browser lay the page out now (style and layout of what the
-/// views changed; the paint still comes with the next frame).
-pub fn lay_out() {
-    #[cfg(target_arch = "wasm32")]
-    if let Some(body) = web_sys::window()
-        .and_then(|w| w.document())
-        .and_then(|d| d.body())
-    {
-        let _ = body.offset_height();
+/// A draw handed to the page: the line waits until the page has painted
+/// it (issue 13: the paint of a redrawn Traffic table, 2-4 ms at the next
+/// frame, held up the ACK of a frame ending under it). Natively (the
+/// tests) there are no frames: it waits until the next tick.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Draw {
+    /// The frames painted when the draw was handed out.
+    since: Option<u64>,
+    /// Handed out since the last tick.
+    fresh: bool,
+}
+
+impl Draw {
+    /// A draw was handed out now.
+    pub fn begin(&mut self) {
+        self.since = Some(frames());
+        self.fresh = true;
     }
+
+    /// Whether the line waits for the draw.
+    pub fn pending(&self) -> bool {
+        self.since.is_some()
+    }
+
+    /// Whether the draw was handed out since the last tick.
+    pub fn fresh(&self) -> bool {
+        self.fresh
+    }
+
+    /// At a tick: the wait ends once a frame has been painted since the
+    /// draw; until then, the page is asked to run after the next one.
+    pub fn settle(&mut self) {
+        self.fresh = false;
+        match self.since {
+            Some(n) if frames() <= n => next_frame(),
+            _ => self.since = None,
+        }
+    }
+}
+
+/// Frames the page has painted so far (natively: one per call).
+fn frames() -> u64 {
+    #[cfg(target_arch = "wasm32")]
+    return page::frames();
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        thread_local!(static FRAMES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) });
+        FRAMES.with(|f| {
+            f.set(f.get() + 1);
+            f.get()
+        })
+    }
+}
+
+/// Has the page run once its next frame is painted.
+fn next_frame() {
+    #[cfg(target_arch = "wasm32")]
+    page::next_frame();
 }
 
 /// Runs the page's work as soon as the page can (bytes came, the user
@@ -155,11 +288,21 @@ pub fn soon() {
     at(0.0);
 }
 
-/// Runs the page's work when the page's clock reaches `page_us` (µs), or
-/// earlier if asked.
+/// Runs the page's work when the page's clock reaches `page_us` (µs), within a
+/// millisecond after, or earlier if asked.
 pub fn at(page_us: f64) {
     #[cfg(target_arch = "wasm32")]
-    page::at(page_us);
+    page::at(page_us, false);
+    #[cfg(not(target_arch = "wasm32"))]
+    let _ = page_us;
+}
+
+/// Runs the page's work when the page's clock reaches `page_us` (µs), to
+/// the clock's resolution: a modem's frame may end then, to be ACKed at
+/// once ([`crate::transport::Transport::uart_due`]).
+pub fn exactly(page_us: f64) {
+    #[cfg(target_arch = "wasm32")]
+    page::at(page_us, true);
     #[cfg(not(target_arch = "wasm32"))]
     let _ = page_us;
 }

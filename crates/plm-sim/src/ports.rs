@@ -39,6 +39,11 @@ pub trait Ports {
     /// Bytes that reached served node `node`'s host by now, with their
     /// arrival times.
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)>;
+    /// When the bytes now on served node `node`'s UART have arrived, the
+    /// earliest of the two ways still to come (`None`: none are on the
+    /// way): a frame may end there, which the modem or the host answers at
+    /// once. The bytes before those ends wait for them.
+    fn uart_due_of(&self, node: usize) -> Option<Instant>;
     /// The next moment anything happens, byte arrivals at the hosts
     /// included.
     fn next_deadline(&self) -> Option<Instant>;
@@ -76,6 +81,9 @@ impl Ports for crate::Sim {
     }
     fn host_read_of(&mut self, node: usize) -> Vec<(Instant, u8)> {
         crate::Sim::host_read_of(self, node)
+    }
+    fn uart_due_of(&self, node: usize) -> Option<Instant> {
+        crate::Sim::uart_due_of(self, node)
     }
     fn next_deadline(&self) -> Option<Instant> {
         crate::Sim::next_deadline(self)

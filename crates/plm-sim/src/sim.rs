@@ -777,6 +777,21 @@ impl Sim {
         drained - self.now
     }
 
+    /// When the bytes now on served node `node`'s UART (or the
+    /// concentrator board's USART) have arrived, the earliest of the two
+    /// ways still to come; `None` when none are on the way.
+    pub fn uart_due_of(&self, node: usize) -> Option<Instant> {
+        let (down, up) = match (self.attach, node) {
+            (Attach::Board, 0) => (&self.usart_down, &self.usart_up),
+            _ => {
+                let n = self.nodes.get(node)?;
+                (&n.down, &n.up)
+            }
+        };
+        let end = |w: &Wire| Some(w.drained_at(self.now)).filter(|&t| t > self.now);
+        earliest(end(down), end(up))
+    }
+
     /// Purges the transmit side of served node `node`'s host (its serial
     /// driver dropping its buffer): the bytes it wrote that have not yet
     /// reached the modem (or the board's USART) are lost, and a T_REQ

@@ -86,6 +86,10 @@ impl Ports for Alarming {
         self.net.host_read_of(node)
     }
 
+    fn uart_due_of(&self, node: usize) -> Option<Instant> {
+        self.net.uart_due_of(node)
+    }
+
     fn next_deadline(&self) -> Option<Instant> {
         Some(
             self.net

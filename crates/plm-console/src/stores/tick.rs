@@ -49,12 +49,6 @@ impl Console {
     /// Lets time pass up to the page's clock, then asks to be run again
     /// when something is next due ([`crate::wake`]).
     pub fn tick(&self) {
-        // Notes were handed out since the last tick, and the line waits:
-        // the page lays them out now rather than while a frame may be
-        // ending ([`crate::session::Session::holds_line`]).
-        if self.session().borrow().drawing() || self.street.read(StreetSession::drawing) {
-            crate::wake::lay_out();
-        }
         let budget = || Budget::wall(page_now_us, TICK_BUDGET_US);
         let tick = self.session().borrow_mut().tick(page_now_us(), budget());
         self.apply(tick);
@@ -74,6 +68,13 @@ impl Console {
         .flatten()
         .fold(now + IDLE_WAKE_US, f64::min);
         crate::wake::at(due);
+        let exact = [
+            self.session().borrow().exact_wake(),
+            self.street.session().borrow().exact_wake(),
+        ];
+        if let Some(exact) = exact.into_iter().flatten().reduce(f64::min) {
+            crate::wake::exactly(exact);
+        }
     }
 
     /// Applies what happened without letting time pass, and has the

@@ -69,6 +69,15 @@ pub trait Transport {
     fn next_event(&self) -> Option<Instant> {
         None
     }
+    /// When the bytes now on the UART have arrived, the earliest of the
+    /// two ways, when the transport knows (a simulated world; a real port
+    /// wakes the page when bytes come): a frame may end there, which the
+    /// modem answers at once, or the host must (a frame to ACK). The page
+    /// wakes for it to its clock's resolution, and for the other events
+    /// ([`Transport::next_event`]) within a millisecond ([`crate::wake`]).
+    fn uart_due(&self) -> Option<Instant> {
+        None
+    }
     /// How late the transport may hand over the modem's bytes, or carry
     /// out the host's, beyond their wire time (0 for a simulated modem):
     /// the host's waits for the modem are lengthened by it.

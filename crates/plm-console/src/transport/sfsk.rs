@@ -141,6 +141,10 @@ impl Transport for SfskTransport {
         self.net.set_resetn_of(0, asserted);
     }
 
+    fn uart_due(&self) -> Option<Instant> {
+        self.net.uart_due_of(0)
+    }
+
     fn next_event(&self) -> Option<Instant> {
         self.net.next_deadline()
     }

@@ -100,6 +100,10 @@ impl Transport for SimTransport {
         self.sim.inject(Fault::Resetn(asserted));
     }
 
+    fn uart_due(&self) -> Option<Instant> {
+        self.sim.uart_due_of(0)
+    }
+
     fn next_event(&self) -> Option<Instant> {
         self.sim.next_deadline()
     }

@@ -138,6 +138,15 @@ impl ModemPort {
         }
     }
 
+    /// When the bytes now on the UART have arrived, the earliest of the
+    /// two ways (`None`: none are on the way).
+    pub fn uart_due(&self) -> Option<Instant> {
+        earliest(
+            self.at_modem.back().map(|b| b.0),
+            self.at_host.back().map(|b| b.0),
+        )
+    }
+
     /// The next moment something is due at the modem or on a wire.
     pub fn next_due(&self) -> Option<Instant> {
         let wires = earliest(

@@ -601,6 +601,11 @@ impl Ports for Network {
             .map_or_else(Vec::new, |n| n.driver.port.host_read())
     }
 
+    fn uart_due_of(&self, node: usize) -> Option<Instant> {
+        let n = self.nodes.get(node).filter(|n| n.driver.is_outside())?;
+        n.driver.port.uart_due()
+    }
+
     fn next_deadline(&self) -> Option<Instant> {
         self.next_due()
     }
