@@ -945,7 +945,7 @@ impl Layer for StreetSession {
     /// Replies go to the views at the instant they came: a reply may send
     /// the next request.
     fn stop(&self) -> bool {
-        !self.out.replies.is_empty() || self.hold.fresh()
+        !self.out.replies.is_empty()
     }
 }
 

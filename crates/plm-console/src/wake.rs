@@ -45,10 +45,6 @@ mod page {
         fn set_timeout(run: &JsValue, ms: u32) -> f64;
         #[wasm_bindgen(js_name = clearTimeout)]
         fn clear_timeout(id: f64);
-        #[wasm_bindgen(js_name = addEventListener)]
-        fn add_event_listener(kind: &str, run: &JsValue);
-        #[wasm_bindgen(js_name = requestAnimationFrame)]
-        fn request_animation_frame(run: &JsValue) -> f64;
     }
 
     struct Waker {
@@ -63,6 +59,7 @@ mod page {
         timer: Option<f64>,
         /// `postMessage`'s origin ("*"), made once.
         origin: JsValue,
+        window: web_sys::Window,
         /// Frames painted since the page opened ([`super::Draw`]).
         frames: u64,
         /// When the next frame was asked for, while it has not come.
@@ -97,7 +94,11 @@ mod page {
             });
             arm();
         });
-        add_event_listener("message", on_message.as_ref());
+        let Some(window) = web_sys::window() else {
+            return;
+        };
+        let _ =
+            window.add_event_listener_with_callback("message", on_message.as_ref().unchecked_ref());
         let on_timer = Closure::<dyn FnMut()>::new(|| {
             with(|w| w.timer = None);
             arm();
@@ -118,6 +119,7 @@ mod page {
                 posted: false,
                 timer: None,
                 origin: JsValue::from_str("*"),
+                window,
                 frames: 0,
                 frame_asked: None,
                 painting: false,
@@ -149,7 +151,7 @@ mod page {
             let ask = w.frame_asked.is_none() && !w.painting;
             if ask {
                 w.frame_asked = Some(now);
-                request_animation_frame(w.on_frame.as_ref());
+                let _ = w.window.request_animation_frame(w.on_frame.as_ref().unchecked_ref());
             }
             ask
         });
@@ -230,15 +232,12 @@ pub fn install(run: impl Fn() + 'static) {
 pub struct Draw {
     /// The frames painted when the draw was handed out.
     since: Option<u64>,
-    /// Handed out since the last tick.
-    fresh: bool,
 }
 
 impl Draw {
     /// A draw was handed out now.
     pub fn begin(&mut self) {
         self.since = Some(frames());
-        self.fresh = true;
     }
 
     /// Whether the line waits for the draw.
@@ -246,15 +245,9 @@ impl Draw {
         self.since.is_some()
     }
 
-    /// Whether the draw was handed out since the last tick.
-    pub fn fresh(&self) -> bool {
-        self.fresh
-    }
-
     /// At a tick: the wait ends once a frame has been painted since the
     /// draw; until then, the page is asked to run after the next one.
     pub fn settle(&mut self) {
-        self.fresh = false;
         match self.since {
             Some(n) if frames() <= n => next_frame(),
             _ => self.since = None,
