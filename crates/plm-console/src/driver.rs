@@ -159,7 +159,9 @@ pub struct Driver {
     page_now: Instant,
     /// The page's clock (µs) at the tick running now.
     tick_at: f64,
-    acks: AckTimes,
+    /// Whether the session's engine ACKs a modem's frames ([`Layer::acks`]).
+    acks: bool,
+    ack_times: AckTimes,
     /// Transport time run by the ticks, and the page's time that took.
     work: (Duration, f64),
 }
@@ -185,13 +187,13 @@ impl Driver {
 
     /// The ACK latency so far.
     pub fn ack_latency(&self) -> AckLatency {
-        self.acks.stats()
+        self.ack_times.stats()
     }
 
     /// Each ACK timed: when it was written (the page's clock, µs) and its
     /// latency on the transport's clock and on the page's.
     pub fn ack_samples(&self) -> Vec<(f64, Duration, Duration)> {
-        self.acks.samples()
+        self.ack_times.samples()
     }
 
     /// Transport time the ticks have run (µs), and the page's time that
@@ -201,11 +203,11 @@ impl Driver {
     }
 
     /// When the page must run to its clock's resolution (µs of the
-    /// page's clock), for a host that ACKs the modem's frames (`acks`):
-    /// the bytes on the UART have arrived one way, and a frame may end
-    /// there ([`Transport::uart_due`]).
-    pub fn exact_wake(&self, acks: bool) -> Option<f64> {
-        let due = self.transport.as_ref()?.uart_due().filter(|_| acks)?;
+    /// page's clock), for a host that ACKs the modem's frames: the bytes
+    /// on the UART have arrived one way, and a frame may end there
+    /// ([`Transport::uart_due`]).
+    pub fn exact_wake(&self) -> Option<f64> {
+        let due = self.transport.as_ref()?.uart_due().filter(|_| self.acks)?;
         self.pacer.page_at(due)
     }
 
@@ -213,7 +215,7 @@ impl Driver {
     /// `at`: one sample, on both clocks.
     fn acked(&mut self, at: Instant) {
         let written = self.now();
-        self.acks.record(
+        self.ack_times.record(
             written.saturating_sub(at),
             self.page_now.max(written).saturating_sub(at),
             self.tick_at,
@@ -347,6 +349,7 @@ pub fn tick(layer: &mut dyn Layer, page_us: f64, budget: Budget) {
     let target = d.pacer.target_within(page_us, start, catch_up, busy);
     d.page_now = d.pacer.page_now();
     d.tick_at = page_us;
+    d.acks = acks;
     let began = budget.now();
     run_within(layer, start, target, budget);
     let (_, d) = layer.parts();

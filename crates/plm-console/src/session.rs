@@ -473,11 +473,6 @@ impl Session {
         [notes, due].into_iter().flatten().reduce(f64::min)
     }
 
-    /// [`Driver::exact_wake`].
-    pub fn exact_wake(&self) -> Option<f64> {
-        self.drive.exact_wake(true)
-    }
-
     /// Hands the next queued request to the engine when none is
     /// outstanding and no duplicate answer is expected.
     fn start_next(&mut self, now: Instant) {

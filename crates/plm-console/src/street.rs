@@ -584,11 +584,6 @@ impl StreetSession {
         self.next_due().and_then(|t| self.drive.pacer.page_at(t))
     }
 
-    /// [`Driver::exact_wake`].
-    pub fn exact_wake(&self) -> Option<f64> {
-        self.drive.exact_wake(self.acks())
-    }
-
     /// The discovery under way.
     fn discovery(&self) -> Option<&Discovery> {
         match self.job.as_ref()?.job() {

@@ -42,9 +42,7 @@ mod page {
         #[wasm_bindgen(js_name = postMessage)]
         fn post_message(message: &JsValue, origin: &JsValue);
         #[wasm_bindgen(js_name = setTimeout)]
-        fn set_timeout(run: &JsValue, ms: u32) -> f64;
-        #[wasm_bindgen(js_name = clearTimeout)]
-        fn clear_timeout(id: f64);
+        fn set_timeout(run: &JsValue, ms: u32);
     }
 
     struct Waker {
@@ -55,8 +53,6 @@ mod page {
         exact: bool,
         /// A message is on its way.
         posted: bool,
-        /// The timer for a later deadline.
-        timer: Option<f64>,
         /// `postMessage`'s origin ("*"), made once.
         origin: JsValue,
         window: web_sys::Window,
@@ -66,9 +62,9 @@ mod page {
         frame_asked: Option<f64>,
         /// A frame is being painted: the next message comes after it.
         painting: bool,
-        on_timer: Closure<dyn FnMut()>,
+        /// Runs at each message and timer: looks whether something is due.
+        on_wake: Closure<dyn FnMut()>,
         on_frame: Closure<dyn FnMut()>,
-        _on_message: Closure<dyn FnMut()>,
     }
 
     /// How long a draw waits for the page's next frame (µs): a hidden or
@@ -84,7 +80,9 @@ mod page {
     }
 
     pub fn install(run: Rc<dyn Fn()>) {
-        let on_message = Closure::<dyn FnMut()>::new(|| {
+        // A timer set for a deadline moved earlier since runs this too,
+        // and finds nothing due: cheaper than keeping and clearing it.
+        let on_wake = Closure::<dyn FnMut()>::new(|| {
             with(|w| {
                 w.posted = false;
                 // Tasks queued during a frame run once it is painted.
@@ -98,11 +96,7 @@ mod page {
             return;
         };
         let _ =
-            window.add_event_listener_with_callback("message", on_message.as_ref().unchecked_ref());
-        let on_timer = Closure::<dyn FnMut()>::new(|| {
-            with(|w| w.timer = None);
-            arm();
-        });
+            window.add_event_listener_with_callback("message", on_wake.as_ref().unchecked_ref());
         let on_frame = Closure::<dyn FnMut()>::new(|| {
             with(|w| {
                 w.frame_asked = None;
@@ -117,47 +111,46 @@ mod page {
                 due: f64::INFINITY,
                 exact: false,
                 posted: false,
-                timer: None,
                 origin: JsValue::from_str("*"),
                 window,
                 frames: 0,
                 frame_asked: None,
                 painting: false,
-                on_timer,
+                on_wake,
                 on_frame,
-                _on_message: on_message,
             })
         });
     }
 
-    /// Frames painted so far; a frame asked for that has not come within
-    /// [`FRAME_WAIT_US`] counts as painted.
+    /// Frames painted so far.
     pub fn frames() -> u64 {
+        with(|w| w.frames)
+    }
+
+    /// Whether a frame was painted since `frames` were (one asked for
+    /// that has not come within [`FRAME_WAIT_US`] counts); if not, the
+    /// next is asked for, and the page runs once it is painted.
+    pub fn painted_since(frames: u64) -> bool {
         let now = page_now_us();
-        with(|w| {
+        let asked = with(|w| {
             if w.frame_asked.is_some_and(|t| now - t > FRAME_WAIT_US) {
                 w.frame_asked = None;
                 w.frames += 1;
             }
-            w.frames
-        })
-    }
-
-    /// Asks for the next frame, if not yet asked; the page runs once it
-    /// is painted, or after [`FRAME_WAIT_US`].
-    pub fn next_frame() {
-        let now = page_now_us();
-        let asked = with(|w| {
+            if w.frames > frames {
+                return None;
+            }
             let ask = w.frame_asked.is_none() && !w.painting;
             if ask {
                 w.frame_asked = Some(now);
                 let _ = w.window.request_animation_frame(w.on_frame.as_ref().unchecked_ref());
             }
-            ask
+            Some(ask)
         });
-        if asked {
+        if asked == Some(true) {
             at(now + FRAME_WAIT_US, false);
         }
+        asked.is_none()
     }
 
     fn with<R: Default>(f: impl FnOnce(&mut Waker) -> R) -> R {
@@ -165,7 +158,7 @@ mod page {
     }
 
     /// Runs if due, else waits for the time left: the whole milliseconds
-    /// by the one timer, the rest by messages.
+    /// by a timer, the rest by messages.
     fn arm() {
         let now = page_now_us();
         let run = with(|w| {
@@ -181,8 +174,8 @@ mod page {
             };
             if ms < 1.0 {
                 w.post();
-            } else if ms.is_finite() && w.timer.is_none() {
-                w.timer = Some(set_timeout(w.on_timer.as_ref(), ms as u32));
+            } else if ms.is_finite() {
+                set_timeout(w.on_wake.as_ref(), ms as u32);
             }
             None
         });
@@ -198,9 +191,6 @@ mod page {
             }
             w.due = page_us;
             w.exact = exact;
-            if let Some(id) = w.timer.take() {
-                clear_timeout(id);
-            }
             w.post();
         });
     }
@@ -248,31 +238,30 @@ impl Draw {
     /// At a tick: the wait ends once a frame has been painted since the
     /// draw; until then, the page is asked to run after the next one.
     pub fn settle(&mut self) {
-        match self.since {
-            Some(n) if frames() <= n => next_frame(),
-            _ => self.since = None,
+        if self.since.is_some_and(painted_since) {
+            self.since = None;
         }
     }
 }
 
-/// Frames the page has painted so far (natively: one per call).
+/// Frames the page has painted so far (natively: none).
 fn frames() -> u64 {
     #[cfg(target_arch = "wasm32")]
     return page::frames();
     #[cfg(not(target_arch = "wasm32"))]
-    {
-        thread_local!(static FRAMES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) });
-        FRAMES.with(|f| {
-            f.set(f.get() + 1);
-            f.get()
-        })
-    }
+    0
 }
 
-/// Has the page run once its next frame is painted.
-fn next_frame() {
+/// Whether the page has painted a frame since `frames` were, else asks
+/// to run once it has (natively: always, there are no frames).
+fn painted_since(frames: u64) -> bool {
     #[cfg(target_arch = "wasm32")]
-    page::next_frame();
+    return page::painted_since(frames);
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let _ = frames;
+        true
+    }
 }
 
 /// Runs the page's work as soon as the page can (bytes came, the user

@@ -68,11 +68,7 @@ impl Console {
         .flatten()
         .fold(now + IDLE_WAKE_US, f64::min);
         crate::wake::at(due);
-        let exact = [
-            self.session().borrow().exact_wake(),
-            self.street.session().borrow().exact_wake(),
-        ];
-        if let Some(exact) = exact.into_iter().flatten().reduce(f64::min) {
+        if let Some(exact) = self.with_driver(Driver::exact_wake) {
             crate::wake::exactly(exact);
         }
     }
