@@ -53,6 +53,10 @@ mod page {
         exact: bool,
         /// A message is on its way.
         posted: bool,
+        /// When the timer set last fires (infinite: none is set). One set
+        /// for a deadline moved earlier since is left to run and find
+        /// nothing due: cheaper than keeping and clearing it.
+        timer_at: f64,
         /// `postMessage`'s origin ("*"), made once.
         origin: JsValue,
         window: web_sys::Window,
@@ -80,8 +84,6 @@ mod page {
     }
 
     pub fn install(run: Rc<dyn Fn()>) {
-        // A timer set for a deadline moved earlier since runs this too,
-        // and finds nothing due: cheaper than keeping and clearing it.
         let on_wake = Closure::<dyn FnMut()>::new(|| {
             with(|w| {
                 w.posted = false;
@@ -111,6 +113,7 @@ mod page {
                 due: f64::INFINITY,
                 exact: false,
                 posted: false,
+                timer_at: f64::INFINITY,
                 origin: JsValue::from_str("*"),
                 window,
                 frames: 0,
@@ -162,6 +165,9 @@ mod page {
     fn arm() {
         let now = page_now_us();
         let run = with(|w| {
+            if w.timer_at <= now + 100.0 {
+                w.timer_at = f64::INFINITY;
+            }
             if w.due <= now + 100.0 {
                 w.due = f64::INFINITY;
                 return Some(w.run.clone());
@@ -174,7 +180,8 @@ mod page {
             };
             if ms < 1.0 {
                 w.post();
-            } else if ms.is_finite() {
+            } else if now + ms * 1_000.0 < w.timer_at {
+                w.timer_at = now + ms * 1_000.0;
                 set_timeout(w.on_wake.as_ref(), ms as u32);
             }
             None
