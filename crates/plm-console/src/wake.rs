@@ -26,17 +26,13 @@
 #[cfg(target_arch = "wasm32")]
 mod page {
     use crate::clock::page_now_us;
-    use std::cell::RefCell;
-    use std::rc::Rc;
+    use std::cell::{Cell, OnceCell};
     use wasm_bindgen::prelude::*;
 
-    // The page's own `postMessage` and timers, called straight: web-sys's
-    // wrap each call in a closure over its arguments to catch what cannot
-    // be thrown here, and pass the origin as a new string, and a timer
-    // each time made a closure of its own. Waiting a fraction of a
-    // millisecond posts a message every few µs, and that garbage (35 MB
-    // in 300 reads) had the page collect it every few hundred ms,
-    // 3-8 ms each, in the middle of a modem's frame.
+    // The page's own `postMessage` and `setTimeout`, called straight:
+    // web-sys's wraps each call in a closure over its arguments, to catch
+    // what cannot be thrown here, and passes the origin as a new string,
+    // and gloo-timers' `Timeout` made a closure for each wait.
     #[wasm_bindgen]
     extern "C" {
         #[wasm_bindgen(js_name = postMessage)]
@@ -45,27 +41,12 @@ mod page {
         fn set_timeout(run: &JsValue, ms: u32);
     }
 
-    struct Waker {
-        run: Rc<dyn Fn()>,
-        /// When to run next, µs of the page's clock (infinite: nothing due).
-        due: f64,
-        /// Whether `due` is met to the clock's resolution ([`super::exactly`]).
-        exact: bool,
-        /// A message is on its way.
-        posted: bool,
-        /// When the timer set last fires (infinite: none is set). One set
-        /// for a deadline moved earlier since is left to run and find
-        /// nothing due: cheaper than keeping and clearing it.
-        timer_at: f64,
-        /// `postMessage`'s origin ("*"), made once.
+    /// What the page gave the wake, once.
+    struct Page {
+        run: Box<dyn Fn()>,
+        /// `postMessage`'s origin ("*").
         origin: JsValue,
         window: web_sys::Window,
-        /// Frames painted since the page opened ([`super::Draw`]).
-        frames: u64,
-        /// When the next frame was asked for, while it has not come.
-        frame_asked: Option<f64>,
-        /// A frame is being painted: the next message comes after it.
-        painting: bool,
         /// Runs at each message and timer: looks whether something is due.
         on_wake: Closure<dyn FnMut()>,
         on_frame: Closure<dyn FnMut()>,
@@ -80,135 +61,130 @@ mod page {
     const PRECISE_MS: f64 = 2.0;
 
     thread_local! {
-        static WAKER: RefCell<Option<Waker>> = const { RefCell::new(None) };
+        static PAGE: OnceCell<Page> = const { OnceCell::new() };
+        /// When to run next, µs of the page's clock (infinite: nothing due).
+        static DUE: Cell<f64> = const { Cell::new(f64::INFINITY) };
+        /// Whether `DUE` is met to the clock's resolution ([`super::exactly`]).
+        static EXACT: Cell<bool> = const { Cell::new(false) };
+        /// A message is on its way.
+        static POSTED: Cell<bool> = const { Cell::new(false) };
+        /// When the timer set last fires (infinite: none is set). One set
+        /// for a deadline moved earlier since is left to run and find
+        /// nothing due: cheaper than keeping and clearing it.
+        static TIMER_AT: Cell<f64> = const { Cell::new(f64::INFINITY) };
+        /// Frames painted since the page opened ([`super::Draw`]).
+        static FRAMES: Cell<u64> = const { Cell::new(0) };
+        /// When the next frame was asked for, while it has not come
+        /// (infinite: none is asked for).
+        static FRAME_ASKED: Cell<f64> = const { Cell::new(f64::INFINITY) };
+        /// A frame is being painted: the next message comes after it.
+        static PAINTING: Cell<bool> = const { Cell::new(false) };
     }
 
-    pub fn install(run: Rc<dyn Fn()>) {
+    pub fn install(run: Box<dyn Fn()>) {
         let on_wake = Closure::<dyn FnMut()>::new(|| {
-            with(|w| {
-                w.posted = false;
-                // Tasks queued during a frame run once it is painted.
-                if std::mem::take(&mut w.painting) {
-                    w.frames += 1;
-                }
-            });
+            POSTED.set(false);
+            // Tasks queued during a frame run once it is painted.
+            if PAINTING.replace(false) {
+                FRAMES.set(FRAMES.get() + 1);
+            }
             arm();
+        });
+        let on_frame = Closure::<dyn FnMut()>::new(|| {
+            FRAME_ASKED.set(f64::INFINITY);
+            PAINTING.set(true);
+            POSTED.set(false);
+            post();
         });
         let Some(window) = web_sys::window() else {
             return;
         };
         let _ =
             window.add_event_listener_with_callback("message", on_wake.as_ref().unchecked_ref());
-        let on_frame = Closure::<dyn FnMut()>::new(|| {
-            with(|w| {
-                w.frame_asked = None;
-                w.painting = true;
-                w.posted = false;
-                w.post();
-            })
-        });
-        WAKER.with(|w| {
-            *w.borrow_mut() = Some(Waker {
+        PAGE.with(|p| {
+            let _ = p.set(Page {
                 run,
-                due: f64::INFINITY,
-                exact: false,
-                posted: false,
-                timer_at: f64::INFINITY,
                 origin: JsValue::from_str("*"),
                 window,
-                frames: 0,
-                frame_asked: None,
-                painting: false,
                 on_wake,
                 on_frame,
-            })
+            });
         });
+        // What was asked for before.
+        post();
     }
 
     /// Frames painted so far.
     pub fn frames() -> u64 {
-        with(|w| w.frames)
+        FRAMES.get()
     }
 
-    /// Whether a frame was painted since `frames` were (one asked for
-    /// that has not come within [`FRAME_WAIT_US`] counts); if not, the
-    /// next is asked for, and the page runs once it is painted.
+    /// Whether a frame was painted since `frames` were, or the page
+    /// paints none (one asked for has not come within [`FRAME_WAIT_US`]);
+    /// if not, the next is asked for, and the page runs once it is
+    /// painted.
     pub fn painted_since(frames: u64) -> bool {
         let now = page_now_us();
-        let asked = with(|w| {
-            if w.frame_asked.is_some_and(|t| now - t > FRAME_WAIT_US) {
-                w.frame_asked = None;
-                w.frames += 1;
-            }
-            if w.frames > frames {
-                return None;
-            }
-            let ask = w.frame_asked.is_none() && !w.painting;
-            if ask {
-                w.frame_asked = Some(now);
-                let _ = w.window.request_animation_frame(w.on_frame.as_ref().unchecked_ref());
-            }
-            Some(ask)
-        });
-        if asked == Some(true) {
+        if FRAMES.get() > frames || now - FRAME_ASKED.get() > FRAME_WAIT_US {
+            return true;
+        }
+        if FRAME_ASKED.get() == f64::INFINITY && !PAINTING.get() {
+            FRAME_ASKED.set(now);
+            PAGE.with(|p| {
+                if let Some(p) = p.get() {
+                    let _ = p.window.request_animation_frame(p.on_frame.as_ref().unchecked_ref());
+                }
+            });
             at(now + FRAME_WAIT_US, false);
         }
-        asked.is_none()
-    }
-
-    fn with<R: Default>(f: impl FnOnce(&mut Waker) -> R) -> R {
-        WAKER.with(|w| w.borrow_mut().as_mut().map(f).unwrap_or_default())
+        false
     }
 
     /// Runs if due, else waits for the time left: the whole milliseconds
     /// by a timer, the rest by messages.
     fn arm() {
         let now = page_now_us();
-        let run = with(|w| {
-            if w.timer_at <= now + 100.0 {
-                w.timer_at = f64::INFINITY;
-            }
-            if w.due <= now + 100.0 {
-                w.due = f64::INFINITY;
-                return Some(w.run.clone());
-            }
-            let left = (w.due - now) / 1_000.0;
-            let ms = if w.exact && left < PRECISE_MS {
-                left.floor()
-            } else {
-                left.ceil()
-            };
-            if ms < 1.0 {
-                w.post();
-            } else if now + ms * 1_000.0 < w.timer_at {
-                w.timer_at = now + ms * 1_000.0;
-                set_timeout(w.on_wake.as_ref(), ms as u32);
-            }
-            None
-        });
-        if let Some(run) = run {
-            run();
+        if TIMER_AT.get() <= now + 100.0 {
+            TIMER_AT.set(f64::INFINITY);
+        }
+        let due = DUE.get();
+        if due <= now + 100.0 {
+            DUE.set(f64::INFINITY);
+            PAGE.with(|p| p.get().map(|p| (p.run)()));
+            return;
+        }
+        let left = (due - now) / 1_000.0;
+        let ms = if EXACT.get() && left < PRECISE_MS {
+            left.floor()
+        } else {
+            left.ceil()
+        };
+        if ms < 1.0 {
+            post();
+        } else if now + ms * 1_000.0 < TIMER_AT.get() {
+            TIMER_AT.set(now + ms * 1_000.0);
+            PAGE.with(|p| p.get().map(|p| set_timeout(p.on_wake.as_ref(), ms as u32)));
         }
     }
 
     pub fn at(page_us: f64, exact: bool) {
-        with(|w| {
-            if page_us > w.due || (page_us == w.due && !exact) {
-                return;
-            }
-            w.due = page_us;
-            w.exact = exact;
-            w.post();
-        });
+        let due = DUE.get();
+        if page_us < due || (exact && page_us == due) {
+            DUE.set(page_us);
+            EXACT.set(exact);
+            post();
+        }
     }
 
-    impl Waker {
-        /// Has the page look again once its tasks queued so far have run.
-        fn post(&mut self) {
-            if !self.posted {
-                post_message(&JsValue::NULL, &self.origin);
-                self.posted = true;
-            }
+    /// Has the page look again once its tasks queued so far have run.
+    fn post() {
+        if !POSTED.get() {
+            PAGE.with(|p| {
+                if let Some(p) = p.get() {
+                    post_message(&JsValue::NULL, &p.origin);
+                    POSTED.set(true);
+                }
+            });
         }
     }
 }
@@ -216,7 +192,7 @@ mod page {
 /// Makes `run` the page's work: [`soon`] and [`at`] call it.
 pub fn install(run: impl Fn() + 'static) {
     #[cfg(target_arch = "wasm32")]
-    page::install(std::rc::Rc::new(run));
+    page::install(Box::new(run));
     #[cfg(not(target_arch = "wasm32"))]
     let _ = run;
 }
