@@ -422,7 +422,8 @@ impl Session {
     /// come when they come. It costs the line up to a frame (16.7 ms at
     /// 60 Hz) once per hand-out.
     pub fn holds_line(&self) -> bool {
-        self.hold.pending() || (!self.out.notes.is_empty() && self.drive.tick_at() >= self.show_at())
+        self.hold.pending()
+            || (!self.out.notes.is_empty() && self.drive.tick_at() >= self.show_at())
     }
 
     /// Whether notes handed out wait to be painted: the line is quiet
