@@ -771,6 +771,37 @@ mod tests {
         }
     }
 
+    /// Only the end of a run of bytes on the UART is waited exactly (a
+    /// frame may end there, to be ACKed or answered): through a ping and
+    /// its answer, the exact wake is a handful of instants, never in the
+    /// past, and no earlier than the next ordinary deadline (each byte of
+    /// a frame), not one per byte.
+    #[test]
+    fn the_exact_wake_is_the_end_of_a_run_of_bytes() {
+        let mut s = session(1);
+        let (mut page, mut notes) = (1_000_000.0, Vec::new());
+        run(&mut s, &mut page, 40, &mut notes);
+        assert_eq!(s.drive.exact_wake(), None, "idle wires");
+        let seen = Seen::default();
+        s.ask(Command::PingRequest { data: vec![7; 8] }, reply(&seen));
+        let (mut ends, mut looks) = (Vec::new(), 0);
+        while seen.borrow().is_empty() {
+            page += 100.0;
+            let t = s.tick(page, Budget::UNLIMITED);
+            t.replies.into_iter().for_each(|(r, o)| r(o));
+            if let Some(end) = s.drive.exact_wake() {
+                assert!(end >= page, "{end} before {page}");
+                assert!(s.next_wake().is_some_and(|w| w <= end));
+                ends.push(end);
+                looks += 1;
+            }
+            assert!(page < 2e6, "the ping answered");
+        }
+        ends.dedup();
+        assert!(looks > 20, "bytes on the wire at {looks} looks");
+        assert!((2..=6).contains(&ends.len()), "{ends:?}");
+    }
+
     /// Issue 13, "event-driven link": the session steps to what is due,
     /// so a modem frame is ACKed at the instant its last byte arrives, and
     /// a request sent from the reply of another leaves at the instant of
