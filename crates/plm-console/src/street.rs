@@ -473,18 +473,20 @@ impl StreetSession {
     /// Whether the discovery's or the sweep's next request is to wait for
     /// the street's views to be drawn: through a bare modem, when they are
     /// due, the line is quiet now (the last request's fate known, no
-    /// window open), so the tick stops, the page draws and lays the views
-    /// out (`Console::tick`), and the next tick sends it
-    /// ([`StreetSession::hold_for_draw`]). A draw while the modem's frames
-    /// may end would hold up their ACKs (T_ACK, UM0932 3.2.8). Through a
-    /// board, the board ACKs its modem: nothing waits.
+    /// window open), so the draw is handed out at the tick's end and the
+    /// request goes once the page has painted it
+    /// ([`StreetSession::hold_for_draw`], [`crate::wake::Draw`]). A draw
+    /// while the modem's frames may end would hold up their ACKs (T_ACK,
+    /// UM0932 3.2.8). Through a board, the board ACKs its modem: nothing
+    /// waits.
     fn draw_first(&self) -> bool {
         let changed = self.out.changed || self.out.sent > 0;
         self.via_modem() && self.shown.due(changed, self.drive.tick_at())
     }
 
     /// The job's request was held back ([`StreetSession::draw_first`]):
-    /// the views are drawn now, and the tick stops for it.
+    /// the views are drawn at the tick's end, and nothing is sent until
+    /// the page has painted them.
     fn hold_for_draw(&mut self) {
         self.out.show = self.shown.show_after(true, self.drive.tick_at(), 0.0);
         self.hold.begin();
@@ -532,12 +534,6 @@ impl StreetSession {
             self.out.found = tick.found;
         }
         tick
-    }
-
-    /// Whether a draw handed out waits to be painted before anything is
-    /// sent.
-    pub fn drawing(&self) -> bool {
-        self.hold.pending()
     }
 
     /// Lets the transport's time catch up with the page's clock.

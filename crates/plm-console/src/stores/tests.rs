@@ -211,9 +211,8 @@ fn a_stamped_byte_keeps_its_time_and_value() {
     }
 }
 
-/// A page whose every redraw of the street takes `draw_us` of its clock,
-/// in the street's views' layout ([`crate::wake::lay_out`] at the next
-/// tick, else the browser's next frame), through discovery and two
+/// A page whose every redraw of the street takes `draw_us` of its clock
+/// (its layout and paint, [`crate::wake::Draw`]), through discovery and two
 /// sweeps over a bare ST7580: the ACKs of the console's host engine, on
 /// the page's clock, and the longest the views went undrawn during
 /// discovery (µs).
