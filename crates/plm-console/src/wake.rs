@@ -5,22 +5,28 @@
 //!
 //! Browsers clamp a `setTimeout` set from inside another timer's callback
 //! to 4 ms once five are nested, which would make every ACK (UM0932
-//! 3.2.8) and every chained request up to 4 ms late. So the wake is always asked for through a message the
-//! page posts to itself (`postMessage`: a task of its own, never clamped),
-//! and the timer for a later deadline is set from that message's task,
-//! where timers do not nest. Any message to the page looks whether
-//! something is due, which costs nothing when nothing is.
+//! 3.2.8) and every chained request up to 4 ms late. So the wake is
+//! always asked for through a message the page posts to itself
+//! (`postMessage`: a task of its own, never clamped), and the timer for a
+//! later deadline is set from that message's task, where timers do not
+//! nest. Any message to the page looks whether something is due, which
+//! costs nothing when nothing is.
 //!
 //! A timer waits whole milliseconds, and rounded up that made an ACK up to
 //! 1 ms late (issue 13: p50 0.5 ms). So the deadline at which the host
 //! must act at once ([`exactly`]: the last byte on the UART either way
-//! arrives, where a frame may end, to be ACKed or answered) is waited, when closer than 2 ms, by the timer's
-//! whole milliseconds rounded down and its last fraction of one by
-//! messages, one after the page's other tasks. Every other deadline (the
-//! world's next byte, the engine's timeouts, the idle wake) is waited by
-//! the timer rounded up: spinning on messages for every byte of a frame
-//! left so much garbage (45 MB in 300 reads) that the page collected it
-//! every few hundred ms, 3-8 ms each, in the middle of a modem's frame.
+//! arrives, where a frame may end, to be ACKed or answered) is waited,
+//! when closer than 2 ms, by the timer's whole milliseconds rounded down
+//! and its last fraction of one by messages, one after the page's other
+//! tasks. Every other deadline (the world's next byte, the engine's
+//! timeouts, the idle wake) is waited by the timer rounded up: spinning on
+//! messages for every byte of a frame left so much garbage (45 MB in 300
+//! reads) that the page collected it every few hundred ms, 3-8 ms each, in
+//! the middle of a modem's frame.
+//!
+//! A draw handed out holds the line until the page has painted it
+//! ([`Draw`]): the page's next frame, counted by the message it posts
+//! from `requestAnimationFrame`, which runs once the frame is painted.
 //! Natively (the tests) there is no page: nothing is run.
 
 #[cfg(target_arch = "wasm32")]
