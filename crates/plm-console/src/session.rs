@@ -450,7 +450,10 @@ impl Session {
     /// arriving), or now if a request waits to be sent.
     pub fn next_due(&self) -> Option<Instant> {
         let now = self.now();
-        let waiting = (self.active.is_none() && !self.queue.is_empty()).then_some(now);
+        // A request held for a draw goes once the page has painted it,
+        // which runs the page again ([`crate::wake::Draw`]).
+        let waiting = (self.active.is_none() && !self.queue.is_empty() && !self.hold.pending())
+            .then_some(now);
         earliest([waiting, self.world_due()])
     }
 

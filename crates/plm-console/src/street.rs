@@ -565,11 +565,17 @@ impl StreetSession {
     /// due: the concentrator's, the discovery's, the sweep's and the
     /// update's deadlines, and the transport's next event.
     pub fn next_due(&self) -> Option<Instant> {
+        // What a draw holds goes once the page has painted it, which runs
+        // the page again ([`crate::wake::Draw`]).
+        let drawing = self.hold.pending();
         earliest([
             self.conc.poll_timeout(),
-            self.job.as_ref().and_then(|j| j.poll_timeout()),
+            self.job
+                .as_ref()
+                .filter(|j| !(drawing && j.is_held()))
+                .and_then(|j| j.poll_timeout()),
             self.next_sweep,
-            (!self.held.is_empty() && !self.slots_open(self.now())).then(|| self.now()),
+            (!self.held.is_empty() && !self.slots_open(self.now()) && !drawing).then(|| self.now()),
             self.update_timeout(),
             self.drive.transport.as_ref().and_then(|t| t.next_event()),
         ])

@@ -91,9 +91,11 @@ mod page {
     pub fn install(run: Box<dyn Fn()>) {
         let on_wake = Closure::<dyn FnMut()>::new(|| {
             POSTED.set(false);
-            // Tasks queued during a frame run once it is painted.
+            // Tasks queued during a frame run once it is painted; then the
+            // page runs, for what waited for the paint.
             if PAINTING.replace(false) {
                 FRAMES.set(FRAMES.get() + 1);
+                DUE.set(0.0);
             }
             arm();
         });
@@ -237,8 +239,9 @@ impl Draw {
     }
 }
 
-/// Frames the page has painted so far (natively: none).
-fn frames() -> u64 {
+/// Frames the page has painted so far, under its own loop ([`install`];
+/// natively: none).
+pub fn frames() -> u64 {
     #[cfg(target_arch = "wasm32")]
     return page::frames();
     #[cfg(not(target_arch = "wasm32"))]
