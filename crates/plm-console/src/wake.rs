@@ -35,10 +35,11 @@ mod page {
     use std::cell::{Cell, OnceCell};
     use wasm_bindgen::prelude::*;
 
-    // The page's own `postMessage` and `setTimeout`, called straight:
-    // web-sys's wraps each call in a closure over its arguments, to catch
-    // what cannot be thrown here, and passes the origin as a new string,
-    // and gloo-timers' `Timeout` made a closure for each wait.
+    // The page's own `postMessage`, `setTimeout` and
+    // `requestAnimationFrame`, called straight: web-sys's wraps each call
+    // in a closure over its arguments, to catch what cannot be thrown
+    // here, and passes the origin as a new string, and gloo-timers'
+    // `Timeout` made a closure for each wait.
     #[wasm_bindgen]
     extern "C" {
         #[wasm_bindgen(js_name = postMessage)]
