@@ -69,7 +69,7 @@ pub fn App() -> impl IntoView {
     // can be resumed, but the boards wait meanwhile).
     let street = console.street;
     let on_leave = window_event_listener(leptos::ev::beforeunload, move |ev| {
-        if street.read(|s| s.campaign().is_some_and(|c| !c.update.is_done())) {
+        if street.read(|s| s.campaign().is_some_and(|c| !c.update().is_done())) {
             ev.prevent_default();
             ev.set_return_value("a firmware update is under way");
         }

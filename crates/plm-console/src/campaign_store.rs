@@ -17,16 +17,16 @@ pub fn save(s: &StreetSession) {
     let Some(c) = s.campaign() else {
         return;
     };
-    if c.update.is_done() {
+    if c.update().is_done() {
         discard();
         return;
     }
-    let progress = hex::encode(&c.update.save());
+    let progress = hex::encode(&c.update().save());
     // The image is written once per campaign: the progress starts with the
     // campaign's header (its size and CRC-32), 21 bytes in.
     let same = |p: &str| p.get(..HEADER_HEX) == progress.get(..HEADER_HEX);
     if !load(PROGRESS).is_some_and(|p| same(&p)) {
-        store(IMAGE, Some(&hex::encode(c.update.image())));
+        store(IMAGE, Some(&hex::encode(c.update().image())));
     }
     store(PROGRESS, Some(&progress));
 }

@@ -1,36 +1,11 @@
-//! A firmware update campaign driven by the street session: plm-core's
-//! [`Update`] engine fed through the session's concentrator, one request
-//! at a time, with pause, cancel, and resume from what was saved.
+//! A firmware update campaign on the street session: plm-core's
+//! ([`plm_core::app::street::Campaign`]), started, paused, cancelled and
+//! resumed from the views on the session's clock.
 
-use super::{Purpose, StreetSession};
-use crate::transport::LinkState;
-use plm_core::app::rfu::image;
-use plm_core::app::update::{Update, UpdateConfig};
-use plm_core::app::{Address, Message, Release};
-use plm_core::time::Instant;
-
-/// A campaign under way (or over, its results kept until dismissed).
-pub struct Campaign {
-    /// The engine.
-    pub update: Update,
-    /// Paused by the user: nothing more is sent until resumed.
-    pub paused: bool,
-    /// When it started or resumed, on the session's clock.
-    pub since: Instant,
-    /// When it was over.
-    pub ended: Option<Instant>,
-    /// A request of the engine is under way.
-    in_flight: bool,
-    /// The sweep ran before: it runs again when the update is over.
-    sweep_was_on: bool,
-}
+use super::StreetSession;
+use plm_core::app::{Address, Release};
 
 impl StreetSession {
-    /// The campaign, if one was started.
-    pub fn campaign(&self) -> Option<&Campaign> {
-        self.campaign.as_ref()
-    }
-
     /// Starts updating `targets` with `image` (reporting release `stated`
     /// once it runs, when the file names none), refused in words (before
     /// anything is sent) when the image cannot be a whole firmware image.
@@ -40,146 +15,30 @@ impl StreetSession {
         stated: Option<Release>,
         targets: &[Address],
     ) -> Result<(), String> {
-        let info = image::check(&image)?.stating(stated)?;
-        let u = Update::new(
-            info.campaign(),
-            info.release,
-            image,
-            targets,
-            UpdateConfig::default(),
-        )?;
-        self.begin(u);
-        Ok(())
+        let now = self.now();
+        self.street.start_update(now, image, stated, targets)
     }
 
-    /// Goes on with a campaign saved by [`Update::save`].
+    /// Goes on with a campaign saved by `Update::save`.
     pub fn resume_update(&mut self, image: Vec<u8>, saved: &[u8]) -> Result<(), String> {
-        let u = Update::resume(image, saved, self.now())?;
-        self.begin(u);
-        Ok(())
-    }
-
-    fn begin(&mut self, update: Update) {
-        let sweep_was_on = self.sweep.on;
-        self.set_sweep(false);
-        self.campaign = Some(Campaign {
-            update,
-            paused: false,
-            since: self.now(),
-            ended: None,
-            in_flight: false,
-            sweep_was_on,
-        });
-        self.out.campaign = true;
+        let now = self.now();
+        self.street.resume_update(now, image, saved)
     }
 
     /// Pauses or resumes sending.
     pub fn pause_update(&mut self, paused: bool) {
-        if let Some(c) = self.campaign.as_mut() {
-            c.paused = paused;
-            self.out.campaign = true;
-        }
+        self.street.pause_update(paused);
     }
 
     /// Cancels: boards not swapped yet forget the campaign and keep their
     /// release; boards swapped already finish.
     pub fn cancel_update(&mut self) {
-        if let Some(c) = self.campaign.as_mut() {
-            c.update.abort();
-            c.paused = false;
-            self.out.campaign = true;
-        }
+        self.street.cancel_update();
     }
 
     /// Forgets a campaign that is over (its results were seen).
     pub fn dismiss_update(&mut self) {
-        if self.campaign.as_ref().is_some_and(|c| c.update.is_done()) {
-            self.campaign = None;
-            self.out.campaign = true;
-        }
-    }
-
-    /// When the engine has something to send again, if it waits for time.
-    pub(super) fn update_timeout(&self) -> Option<Instant> {
-        self.campaign.as_ref().and_then(|c| c.update.poll_timeout())
-    }
-
-    /// Hands the engine's next request to the concentrator.
-    pub(super) fn run_update(&mut self, now: Instant) {
-        let Some(c) = self.campaign.as_mut() else {
-            return;
-        };
-        if c.in_flight || (c.paused && !c.update.is_aborting()) || c.update.is_done() {
-            return;
-        }
-        // With the cable out the campaign waits (its state is saved); it
-        // goes on once connected again.
-        if matches!(self.state(), LinkState::Disconnected(_)) {
-            return;
-        }
-        let Some(c) = self.campaign.as_mut() else {
-            return;
-        };
-        if let Some(r) = c.update.poll(now) {
-            c.in_flight = true;
-            self.out.campaign = true;
-            let broadcast = r.broadcast;
-            self.submit(r, Purpose::Update(broadcast));
-        }
-        if self.campaign.as_ref().is_some_and(|c| c.update.is_done()) {
-            self.update_over();
-        }
-    }
-
-    /// The fate of the engine's request.
-    pub(super) fn update_answer(
-        &mut self,
-        now: Instant,
-        broadcast: bool,
-        r: Result<Message, String>,
-    ) {
-        let Some(c) = self.campaign.as_mut() else {
-            return;
-        };
-        c.in_flight = false;
-        if !broadcast {
-            c.update.on_answer(now, r);
-            self.out.campaign = true;
-        }
-        if c.update.is_done() {
-            self.update_over();
-        }
-    }
-
-    fn update_over(&mut self) {
-        let Some(c) = self.campaign.as_ref() else {
-            return;
-        };
-        let stated = c.update.header().release();
-        let done: Vec<(Address, Option<Release>)> = c
-            .update
-            .boards()
-            .enumerate()
-            .filter(|(_, (_, s))| **s == plm_core::app::update::BoardState::Done)
-            .map(|(i, (a, _))| (a, stated.or(c.update.firmware(i))))
-            .collect();
-        let sweep = c.sweep_was_on;
-        let now = self.now();
-        for (a, release) in done {
-            if let (Some(d), Some(r)) = (self.lamp(a).discovered.as_mut(), release) {
-                d.firmware = r;
-            }
-        }
-        self.out.campaign = true;
-        self.out.changed = true;
-        self.out.found = true;
-        if sweep {
-            self.set_sweep(true);
-        }
-        if let Some(c) = self.campaign.as_mut() {
-            c.sweep_was_on = false;
-            c.ended.get_or_insert(now);
-        }
+        self.street.dismiss_update();
     }
 }
 
@@ -245,8 +104,8 @@ mod tests {
         assert!(!s.sweep().on, "the sweep leaves the line to the update");
         run(&mut s, 120 * S);
         let c = s.campaign().unwrap();
-        assert!(c.update.is_done(), "{:?}", c.update.report());
-        assert!(c.update.boards().all(|(_, st)| *st == BoardState::Done));
+        assert!(c.update().is_done(), "{:?}", c.update().report());
+        assert!(c.update().boards().all(|(_, st)| *st == BoardState::Done));
         assert_eq!(release_of(&s, 1), NEW);
         assert_eq!(release_of(&s, 2), NEW);
         assert_eq!(release_of(&s, 3), old);
@@ -269,7 +128,7 @@ mod tests {
             .unwrap();
         run(&mut s, 60 * S);
         let c = s.campaign().unwrap();
-        let report = c.update.report();
+        let report = c.update().report();
         assert!(
             report[0]
                 .1
@@ -284,7 +143,7 @@ mod tests {
             .unwrap();
         run(&mut s, 60 * S);
         let c = s.campaign().unwrap();
-        assert_eq!(c.update.report()[0].1, "updated to 2.1");
+        assert_eq!(c.update().report()[0].1, "updated to 2.1");
         assert_eq!(release_of(&s, 2), stated);
         s.dismiss_update();
 
@@ -310,7 +169,7 @@ mod tests {
         s.start_update(image.clone(), None, &[street_address(1), street_address(2)])
             .unwrap();
         run(&mut s, 6 * S);
-        let saved = s.campaign().unwrap().update.save();
+        let saved = s.campaign().unwrap().update().save();
         // The page goes; the street (behind the cable) stays.
         let transport = s.drive.transport.take().unwrap();
         let mut s = StreetSession::new(transport, Concentrator::usart(RequesterConfig::default()));
@@ -321,7 +180,7 @@ mod tests {
         s.resume_update(image.clone(), &saved).unwrap();
         // A damaged save (cut short, or with a byte changed) is refused
         // and the running campaign goes on as it was.
-        let running = s.campaign().unwrap().update.save();
+        let running = s.campaign().unwrap().update().save();
         for n in 0..saved.len() {
             assert!(s.resume_update(image.clone(), &saved[..n]).is_err());
         }
@@ -331,13 +190,13 @@ mod tests {
             .resume_update(image, &wrong)
             .unwrap_err()
             .contains("not a saved"));
-        assert_eq!(s.campaign().unwrap().update.save(), running);
+        assert_eq!(s.campaign().unwrap().update().save(), running);
         run(&mut s, 120 * S);
         let c = s.campaign().unwrap();
         assert!(
-            c.update.boards().all(|(_, st)| *st == BoardState::Done),
+            c.update().boards().all(|(_, st)| *st == BoardState::Done),
             "{:?}",
-            c.update.report()
+            c.update().report()
         );
     }
 }

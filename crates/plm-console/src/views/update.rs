@@ -116,7 +116,7 @@ pub fn UpdateView(tab: RwSignal<String>) -> impl IntoView {
     let make_size = signal(String::from("24576"));
     let running = move || {
         street.campaign.track();
-        street.read(|s| s.campaign().map(|c| !c.update.is_done()))
+        street.read(|s| s.campaign().map(|c| !c.update().is_done()))
     };
 
     let on_file = move |ev: leptos::ev::Event| {
@@ -335,7 +335,7 @@ fn snapshot(street: StreetStore) -> Option<Snapshot> {
     street.read(|s| {
         let now = s.now();
         let c = s.campaign()?;
-        let u = &c.update;
+        let u = c.update();
         let report = u.report();
         let lines: Vec<Line> = u
             .boards()

@@ -304,16 +304,45 @@ impl<J: Job> Run<J> {
     }
 }
 
-/// The loop of every street driver: runs `run` on `conc` over `io` until
-/// the job is over or `limit` is reached (returns whether it is over).
-/// `each` is called after every turn with its time and its happenings
-/// (often none), which the job has already had.
-pub fn drive<J: Job, I: Io + ?Sized>(
-    run: &mut Run<J>,
+/// What routes a concentrator's happenings to the work it runs: a
+/// [`Run`] of one job, or the whole street
+/// ([`super::street::Street`]). [`drive`] drives any.
+pub trait Router {
+    /// Its work at `now`, after a turn: the next requests submitted.
+    fn pump(&mut self, conc: &mut Concentrator, now: Instant);
+    /// A happening of the concentrator.
+    fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening);
+    /// When [`Router::pump`] is due for time.
+    fn poll_timeout(&self, now: Instant) -> Option<Instant>;
+    /// Whether it is over (the driver stops).
+    fn is_done(&self) -> bool;
+}
+
+impl<J: Job> Router for Run<J> {
+    fn pump(&mut self, conc: &mut Concentrator, now: Instant) {
+        Run::pump(self, conc, now);
+    }
+    fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening) {
+        Run::handle(self, conc, now, h);
+    }
+    fn poll_timeout(&self, _: Instant) -> Option<Instant> {
+        Run::poll_timeout(self)
+    }
+    fn is_done(&self) -> bool {
+        Run::is_done(self)
+    }
+}
+
+/// The loop of every street driver: runs `run` (a job's [`Run`], or the
+/// street) on `conc` over `io` until it is over or `limit` is reached
+/// (returns whether it is over). `each` is called after every turn with
+/// its time and its happenings (often none), which `run` has already had.
+pub fn drive<T: Router + ?Sized, I: Io + ?Sized>(
+    run: &mut T,
     conc: &mut Concentrator,
     io: &mut I,
     limit: Instant,
-    mut each: impl FnMut(&mut Run<J>, Instant, &[Happening]) -> Result<(), I::Error>,
+    mut each: impl FnMut(&mut T, Instant, &[Happening]) -> Result<(), I::Error>,
 ) -> Result<bool, I::Error> {
     let mut seen = alloc::vec::Vec::new();
     loop {
@@ -334,7 +363,7 @@ pub fn drive<J: Job, I: Io + ?Sized>(
             drive::flush(conc, io)?;
             return Ok(run.is_done());
         }
-        let until = run.poll_timeout().map_or(limit, |t| t.min(limit));
+        let until = run.poll_timeout(now).map_or(limit, |t| t.min(limit));
         drive::turn(conc, io, until, |_, _| {})?;
     }
 }

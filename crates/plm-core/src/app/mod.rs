@@ -13,7 +13,9 @@
 //!   answers, timeouts and retries; [`concentrator`]: both over a board's
 //!   USART or a bare ST7580; [`discovery`]: finding the boards on a line;
 //!   [`read_all`]: reading many boards in slots; [`job`]: any of these
-//!   run on a concentrator by one loop.
+//!   run on a concentrator by one loop; [`street`]: the street
+//!   orchestrated (discovery, the sweep, dimming, the update campaign,
+//!   the fleet and its alerts).
 //! - [`energy`]: a lamp's energy estimated from its power readings.
 //! - [`rfu`]: remote firmware update, the layouts of its commands;
 //!   [`update`]: the engine that updates one board or a street.
@@ -36,6 +38,7 @@ mod release;
 pub mod requester;
 pub mod rfu;
 pub mod service;
+pub mod street;
 pub mod sweep;
 pub mod update;
 pub mod usart;
