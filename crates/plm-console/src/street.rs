@@ -237,7 +237,7 @@ impl StreetSession {
     pub fn request(&mut self, request: Request, reply: StreetReply) -> Result<(), String> {
         request.message.validate()?;
         if let Some(why) = self.down() {
-            self.out.replies.push((reply, Err(why)));
+            self.street.refuse(reply, why);
             return Ok(());
         }
         let now = self.now();
@@ -274,13 +274,15 @@ impl StreetSession {
     /// What happened since the last call, without letting time pass.
     pub fn take(&mut self) -> StreetTick {
         let c = self.street.take();
-        let out = &mut self.out;
-        out.changed |= c.changed;
-        out.alerts.extend(c.alerts);
-        out.replies.extend(c.replies);
-        out.campaign |= c.campaign;
-        out.found |= c.found;
-        std::mem::take(out)
+        let out = std::mem::take(&mut self.out);
+        StreetTick {
+            changed: c.changed,
+            alerts: c.alerts,
+            replies: c.replies,
+            campaign: c.campaign,
+            found: c.found || out.found,
+            ..out
+        }
     }
 
     /// What happened since the last call, without letting time pass, and
@@ -384,7 +386,7 @@ impl Layer for StreetSession {
             Happening::Link(host::Event::Received(el)) => self.link_traffic(now, el, "modem"),
             _ => {}
         }
-        self.street.handle(&mut self.conc, now, &h);
+        self.street.handle(&mut self.conc, now, h);
     }
 
     fn next_due(&self) -> Option<Instant> {
@@ -408,7 +410,7 @@ impl Layer for StreetSession {
     /// Replies go to the views at the instant they came: a reply may send
     /// the next request.
     fn stop(&self) -> bool {
-        !self.out.replies.is_empty() || !self.street.changes().replies.is_empty()
+        !self.street.changes().replies.is_empty()
     }
 }
 

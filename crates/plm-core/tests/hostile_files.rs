@@ -201,7 +201,7 @@ fn saved_campaign() -> Vec<u8> {
     let mut now = 0;
     for _ in 0..8 {
         if u.poll(now).is_some() {
-            u.on_answer(now, Err("silent".into()));
+            u.on_answer(now, Err("silent"));
         }
         now += 250_000;
     }
@@ -218,7 +218,7 @@ fn resume_and_run(saved: &[u8]) -> Result<(), String> {
             break;
         }
         if u.poll(now).is_some() {
-            u.on_answer(now, Err("silent".into()));
+            u.on_answer(now, Err("silent"));
         }
         now += 100_000;
     }

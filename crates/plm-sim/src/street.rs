@@ -4,7 +4,7 @@
 //! way in ([`Attach`]). Tests and `cargo xtask bench` use it.
 
 use crate::sim::{Attach, Sim};
-use plm_core::app::job::{self, Begun, Job, Run};
+use plm_core::app::job::{self, Begun, Job, Router, Run};
 use plm_core::app::read_all::ReadAll;
 use plm_core::app::{
     Address, AppEvent, Concentrator, Discovery, Happening, Message, Request, RequestId,
@@ -151,19 +151,22 @@ impl StreetDriver {
     /// it ended.
     pub fn run_job<J: Job>(&mut self, job: J, limit: Duration) -> (J, bool) {
         let mut run = Run::new(job);
-        let until = self.sim.now() + limit;
-        let log = &mut self.log;
-        let Ok(done) = job::drive(
-            &mut run,
-            &mut self.conc,
-            &mut self.sim,
-            until,
-            |_, at, hs| {
-                log.extend(hs.iter().map(|h| (at, h.clone())));
-                Ok(())
-            },
-        );
+        let done = self.drive(&mut run, limit);
         (run.into_job(), done)
+    }
+
+    /// Drives `router` (a job's [`Run`], or plm-core's whole
+    /// [`plm_core::app::street::Street`]) with plm-core's loop
+    /// ([`job::drive`]) until it is over (a street: idle) or `limit` has
+    /// passed; returns whether it is over.
+    pub fn drive<T: Router>(&mut self, router: &mut T, limit: Duration) -> bool {
+        let until = self.sim.now().saturating_add(limit);
+        let log = &mut self.log;
+        let Ok(done) = job::drive(router, &mut self.conc, &mut self.sim, until, |_, at, hs| {
+            log.extend(hs.iter().map(|h| (at, h.clone())));
+            Ok(())
+        });
+        done
     }
 
     /// Runs a firmware update campaign to its end.

@@ -222,7 +222,7 @@ fn run(seed: u64, tried: &mut Tried) -> (usize, usize) {
         };
         if !broadcast {
             // After a resume the engine waits for no answer: ignored.
-            u.on_answer(d.now(), answer);
+            u.on_answer(d.now(), answer.as_ref().map_err(String::as_str));
         }
     }
     // Power back everywhere, time to confirm, then one more start each.

@@ -9,7 +9,7 @@
 use super::Failure;
 use crate::port::Port;
 use plm_core::app::discovery::{DiscoveryConfig, Rounds};
-use plm_core::app::job::{self, Begun, Job, Run};
+use plm_core::app::job::{self, Begun, Router, Run};
 use plm_core::app::sweep::Round;
 use plm_core::app::{
     Address, AppEvent, AppFrame, Concentrator, Discovered, Discovery, Happening, Message, Request,
@@ -168,12 +168,18 @@ impl Driver {
         })
     }
 
-    /// Runs `run` to its end (plm-core's loop, [`job::drive`]); `each` is
-    /// called after every turn with the happenings it brought.
-    pub fn run<J: Job>(
+    /// The concentrator.
+    pub fn concentrator(&self) -> &Concentrator {
+        &self.conc
+    }
+
+    /// Runs `run` (a job's [`Run`], or plm-core's street) to its end
+    /// (plm-core's loop, [`job::drive`]); `each` is called after every
+    /// turn with the happenings it brought.
+    pub fn run<T: Router>(
         &mut self,
-        run: &mut Run<J>,
-        each: impl FnMut(&mut Run<J>, Instant, &[Happening]) -> Result<(), Failure>,
+        run: &mut T,
+        each: impl FnMut(&mut T, Instant, &[Happening]) -> Result<(), Failure>,
     ) -> Result<(), Failure> {
         job::drive(run, &mut self.conc, &mut self.wall, FOREVER, each).map(|_| ())
     }

@@ -5,11 +5,10 @@ use super::driver::Driver;
 use super::{exit, Failure, Target};
 use plm_core::app::discovery::DiscoveryConfig;
 use plm_core::app::hid::{self, Ballast, Hid};
-use plm_core::app::read_all::ReadConfig;
-use plm_core::app::sweep::{Known, Reading, Round, RoundConfig};
+use plm_core::app::street::Street;
+use plm_core::app::sweep::SLOTS_FROM;
 use plm_core::app::{Address, AppEvent, Message, Request, Service};
 use serde_json::{json, Map, Value};
-use std::collections::BTreeMap;
 
 /// Discovers the boards; prints each as it is found.
 pub fn discover(
@@ -62,68 +61,52 @@ pub fn discover(
     Ok(exit::OK)
 }
 
-/// `status all`: discovers the street, then reads every lamp found (its
-/// HID ballast parameters) with plm-core's round of reads
-/// (docs/board-protocol.md, "A round of reads"): in slots, the stragglers
-/// one by one; one line (or JSON object) per lamp.
+/// `status all`: plm-core's street ([`Street`], what the console's Street
+/// page runs) discovers the boards, then reads every lamp found in its
+/// first round (docs/board-protocol.md, "A round of reads": in slots, the
+/// stragglers one by one); one line (or JSON object) per lamp.
 pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result<u8, Failure> {
     let started = std::time::Instant::now();
     tell!("plm board: discovering, then reading every lamp found");
-    let found = d.discover(config, false, |_, _| {})?.found().to_vec();
-    let reads = RoundConfig {
-        read: ReadConfig {
-            timing: config.timing,
-            ..ReadConfig::ALL
-        },
-        ..RoundConfig::READS
-    };
-    tell!(
-        "plm board: {} board(s) found in {:.1} s; reading them {}",
-        found.len(),
-        started.elapsed().as_secs_f64(),
-        if found.len() < reads.slots_from {
-            "one by one"
-        } else {
-            "in slots, the lamps not heard in theirs one by one"
+    let mut street = Street::<()>::new(d.concentrator());
+    street.set_session(config.session.wrapping_sub(1));
+    street.discover_expecting(d.now(), config.guess);
+    let mut told = false;
+    d.run(&mut street, |s, _, _| {
+        if !told && s.discovering().is_none() {
+            told = true;
+            let n = s.fleet().len();
+            tell!(
+                "plm board: {n} board(s) found in {:.1} s; reading them {}",
+                started.elapsed().as_secs_f64(),
+                if n < SLOTS_FROM {
+                    "one by one"
+                } else {
+                    "in slots, the lamps not heard in theirs one by one"
+                }
+            );
         }
-    );
-    // Discovery has just given every SNR: no lamp is asked it.
-    let now = d.now();
-    let lamps = found
-        .iter()
-        .map(|(address, info)| Known {
-            address: *address,
-            discovered: Some(*info),
-            snr_at: Some(now),
-        })
-        .collect();
-    let mut round = Round::new(lamps, reads);
-    d.run_round(&mut round)?;
-    let mut got = BTreeMap::new();
-    for r in round.take_readings() {
-        match r {
-            Reading::Value(a, value) => got.insert(a, Ok(value)),
-            Reading::Failed(a, why) => got.insert(a, Err(why)),
-            _ => None,
-        };
-    }
+        Ok(())
+    })?;
     let mut silent = 0;
-    for (address, info) in &found {
-        let lamp = match got.remove(address) {
-            Some(Ok(value)) => {
-                Ballast::decode(&value).ok_or_else(|| String::from("a short ballast reply"))
-            }
-            Some(Err(why)) => Err(why),
-            None => Err(String::from("not read")),
+    for lamp in street.fleet().values() {
+        let address = lamp.address;
+        let (firmware, snr) = lamp
+            .discovered
+            .map_or((String::from("?"), 0), |i| (i.firmware.to_string(), i.snr));
+        let read = match (lamp.ballast, &lamp.unreachable) {
+            (Some(b), _) => Ok(b),
+            (None, Some(why)) => Err(why.clone()),
+            (None, None) => Err(String::from("not read")),
         };
-        silent += usize::from(lamp.is_err());
+        silent += usize::from(read.is_err());
         if json {
             let mut o = json!({
                 "address": address.to_string(),
-                "firmware": info.firmware.to_string(),
-                "snr_db": info.snr,
+                "firmware": firmware,
+                "snr_db": snr,
             });
-            match &lamp {
+            match &read {
                 Ok(b) => {
                     o["state"] = b.state().to_string().into();
                     o["lamp_power_w"] = b.lamp_power.into();
@@ -133,24 +116,21 @@ pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result
             }
             say!("{o}");
         } else {
-            let what = match &lamp {
+            let what = match &read {
                 Ok(b) => format!("{}, {} W, {} °C", b.state(), b.lamp_power, b.temperature),
                 Err(why) => why.clone(),
             };
-            say!(
-                "{address}  firmware {}  SNR {} dB  {what}",
-                info.firmware,
-                info.snr
-            );
+            say!("{address}  firmware {firmware}  SNR {snr} dB  {what}");
         }
     }
+    let n = street.fleet().len();
     tell!(
         "plm board: {} lamp(s) read, {silent} silent, in {:.1} s; {} heard in their slot",
-        found.len() - silent,
+        n - silent,
         started.elapsed().as_secs_f64(),
-        round.in_slots()
+        street.sweep().in_slots
     );
-    Ok(if found.is_empty() || silent > 0 {
+    Ok(if n == 0 || silent > 0 {
         exit::FAILED
     } else {
         exit::OK

@@ -141,7 +141,7 @@ impl Job for Update {
         Update::poll(self, now)
     }
     fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>) {
-        Update::on_answer(self, now, answer.cloned().map_err(String::from))
+        Update::on_answer(self, now, answer)
     }
     fn hear(&mut self, _: Address, _: &Message) -> Option<AppFrame> {
         None

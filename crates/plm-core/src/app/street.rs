@@ -31,9 +31,7 @@ use super::message::Message;
 use super::requester::{AppEvent, Request, RequestId};
 use super::service::{Discovered, Service};
 use super::sweep::{Known, Round, RoundConfig};
-use super::update::Update;
 use crate::time::{Duration, Instant, MS};
-use alloc::boxed::Box;
 use alloc::collections::BTreeMap;
 use alloc::string::String;
 use alloc::vec::Vec;
@@ -108,11 +106,10 @@ enum Purpose<R> {
 }
 
 /// The job that has the street's line: a discovery or the sweep's round
-/// (never both), or the update (beside them, in its own [`Run`]).
-pub(crate) enum StreetJob {
+/// (never both; the update runs beside them, in its own [`Run`]).
+enum StreetJob {
     Discovery(Begun<Discovery>),
     Round(Round),
-    Update(Box<Update>),
 }
 
 impl StreetJob {
@@ -120,14 +117,12 @@ impl StreetJob {
         match self {
             StreetJob::Discovery(d) => d,
             StreetJob::Round(r) => r,
-            StreetJob::Update(u) => &**u,
         }
     }
     fn get_mut(&mut self) -> &mut dyn Job {
         match self {
             StreetJob::Discovery(d) => d,
             StreetJob::Round(r) => r,
-            StreetJob::Update(u) => &mut **u,
         }
     }
 }
@@ -164,6 +159,8 @@ pub struct Street<R> {
     /// A street recalled: once its lamps are read, discovery looks for
     /// new ones.
     look_for_new: bool,
+    /// A discovery has just ended: the next round needs no probe.
+    just_found: bool,
     sweep: Sweep,
     next_sweep: Option<Instant>,
     fleet: BTreeMap<Address, Lamp>,
@@ -185,6 +182,7 @@ impl<R> Street<R> {
             found_before_frame: 0,
             session_no: 0,
             look_for_new: false,
+            just_found: false,
             sweep: Sweep::default(),
             next_sweep: None,
             fleet: BTreeMap::new(),
@@ -244,10 +242,14 @@ impl<R> Street<R> {
 
     /// Starts a discovery (a new session: every board answers again).
     pub fn discover(&mut self, now: Instant) {
+        self.discover_expecting(now, self.fleet.len().max(12));
+    }
+
+    /// [`Street::discover`], with about `guess` boards expected.
+    pub fn discover_expecting(&mut self, now: Instant, guess: usize) {
         self.session_no = self.session_no.wrapping_add(1);
         self.look_for_new = false;
-        let expected = self.fleet.len().max(12);
-        let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, expected));
+        let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, guess));
         self.job = Some(Run::new(StreetJob::Discovery(Begun::new(d, Some(first)))));
         self.found_before_frame = 0;
         self.out.found = true;
@@ -394,15 +396,18 @@ impl<R> Street<R> {
         let hold = line == Line::Held;
         let job = self.job.as_ref().filter(|j| !(hold && j.is_held()));
         let held = !self.held.is_empty() && !self.slots_open(now) && !hold;
-        [
-            job.and_then(|j| j.poll_timeout()),
+        let mut t = job.and_then(|j| j.poll_timeout());
+        for u in [
             self.next_sweep,
             held.then_some(now),
             self.campaign.as_ref().and_then(Campaign::poll_timeout),
-        ]
-        .into_iter()
-        .flatten()
-        .min()
+        ] {
+            t = match (t, u) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+        }
+        t
     }
 
     /// Whether nothing is under way: no job, no update sending, no
@@ -416,7 +421,7 @@ impl<R> Street<R> {
     fn discovery(&self) -> Option<&Discovery> {
         match self.job.as_ref()?.job() {
             StreetJob::Discovery(d) => Some(&d.job),
-            _ => None,
+            StreetJob::Round(_) => None,
         }
     }
 
@@ -424,7 +429,7 @@ impl<R> Street<R> {
     fn round(&self) -> Option<&Round> {
         match self.job.as_ref()?.job() {
             StreetJob::Round(r) => Some(r),
-            _ => None,
+            StreetJob::Discovery(_) => None,
         }
     }
 
@@ -463,14 +468,16 @@ impl<R> Street<R> {
             // A street just found is read at once.
             self.next_sweep = Some(now);
             self.sweep.on = true;
+            self.just_found = true;
         }
     }
 
     /// The round a sweep starts now: every lamp of the fleet, the SNR
     /// asked through a board only (through a bare modem every frame heard
-    /// carries it), and the probe for new boards unless a discovery looks
-    /// for them after this round (docs/console.md, "Street").
-    fn new_round(&self) -> Round {
+    /// carries it), and the probe for new boards unless a discovery has
+    /// just looked for them or looks after this round (docs/console.md,
+    /// "Street").
+    fn new_round(&mut self) -> Round {
         let lamps = self
             .fleet
             .values()
@@ -481,7 +488,7 @@ impl<R> Street<R> {
             })
             .collect();
         let mut config = RoundConfig::sweep(self.session_no, !self.modem);
-        if self.look_for_new {
+        if self.look_for_new || core::mem::take(&mut self.just_found) {
             config.probe = None;
         }
         Round::new(lamps, config)
@@ -537,19 +544,25 @@ impl<R> Street<R> {
     /// A happening of the concentrator: the fate of a request, or what a
     /// board sent unasked (the job hears it first, and its answer is
     /// sent).
-    pub fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening) {
-        let job = (self.job.as_mut()).is_some_and(|run| run.handle(conc, now, h));
-        let update = !job && self.campaign_handle(conc, now, h);
+    pub fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: Happening) {
+        let job = (self.job.as_mut()).is_some_and(|run| run.handle(conc, now, &h));
+        let update = !job && self.campaign_handle(conc, now, &h);
         match h {
             Happening::App(e) => self.on_app(conc, now, e, job, update),
             Happening::Heard { address, snr } => {
-                if let Some(l) = self.fleet.get_mut(address).filter(|_| snr.is_some()) {
-                    l.snr = *snr;
+                if let Some(l) = self.fleet.get_mut(&address).filter(|_| snr.is_some()) {
+                    l.snr = snr;
                     l.snr_at = Some(now);
                 }
             }
             _ => {}
         }
+    }
+
+    /// Tells the caller's request `reply` failed before it was sent
+    /// (the cable is out), with the other outcomes.
+    pub fn refuse(&mut self, reply: R, why: String) {
+        self.out.replies.push((reply, Err(why)));
     }
 
     /// What an application event means for the fleet and the callers'
@@ -559,7 +572,7 @@ impl<R> Street<R> {
         &mut self,
         conc: &mut Concentrator,
         now: Instant,
-        e: &AppEvent,
+        e: AppEvent,
         job: bool,
         update: bool,
     ) {
@@ -568,17 +581,17 @@ impl<R> Street<R> {
                 address,
                 message: Message::Service(Service::DiscoverReply(r)),
                 ..
-            } if job && self.discovery().is_some() => self.discovered(now, *address, *r),
+            } if job && self.discovery().is_some() => self.discovered(now, address, r),
             AppEvent::Answered {
                 id,
                 address,
                 answer,
                 ..
             } => {
-                let purpose = self.purpose(*id);
-                self.answered(now, *address);
+                let purpose = self.purpose(id);
+                self.answered(now, address);
                 if let Some(p) = purpose {
-                    self.fulfil(conc, now, p, Ok(answer.clone()));
+                    self.fulfil(conc, now, p, Ok(answer));
                 }
             }
             AppEvent::Failed {
@@ -586,17 +599,17 @@ impl<R> Street<R> {
                 address,
                 reason,
             } => {
-                let p = self.purpose(*id);
+                let p = self.purpose(id);
                 let ours = job || update || p.is_some();
-                if ours && *address != Address::BROADCAST && self.fleet.contains_key(address) {
-                    self.unreachable(now, *address, reason);
+                if ours && address != Address::BROADCAST && self.fleet.contains_key(&address) {
+                    self.unreachable(now, address, &reason);
                 }
                 if let Some(p) = p {
-                    self.fulfil(conc, now, p, Err(reason.clone()));
+                    self.fulfil(conc, now, p, Err(reason));
                 }
             }
             AppEvent::Sent { id } => {
-                if let Some(p) = self.purpose(*id) {
+                if let Some(p) = self.purpose(id) {
                     self.fulfil(conc, now, p, Ok(Message::Ping));
                 }
                 return;
@@ -622,7 +635,7 @@ impl<R> Router for Street<R> {
         Street::pump(self, conc, now, Line::Free)
     }
     fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening) {
-        Street::handle(self, conc, now, h)
+        Street::handle(self, conc, now, h.clone())
     }
     fn poll_timeout(&self, now: Instant) -> Option<Instant> {
         // The next sweep is not waited for: the street is idle until then.

@@ -564,7 +564,7 @@ impl Update {
 
     /// What became of the last request: the board's answer, or why there
     /// was none (the requester gave up).
-    pub fn on_answer(&mut self, now: Instant, answer: Result<Message, String>) {
+    pub fn on_answer(&mut self, now: Instant, answer: Result<&Message, &str>) {
         let Waiting::Answer(b) = self.waiting else {
             return;
         };
@@ -585,7 +585,7 @@ impl Update {
             return;
         }
         self.targets[b].state = match (state, answer) {
-            (state, Err(why)) => self.silent(b, now, state, why),
+            (state, Err(why)) => self.silent(b, now, state, why.into()),
             (BoardState::Announcing, Ok(Message::Ack { .. })) => BoardState::Receiving {
                 missing: Vec::new(),
                 asked: 0,
@@ -597,7 +597,7 @@ impl Update {
                 "refused the image (ask its RFU status for the reason)".into(),
             ),
             (BoardState::Receiving { asked, .. }, Ok(Message::Service(Service::RfuStatus(s)))) => {
-                self.after_status(b, &s, asked)
+                self.after_status(b, s, asked)
             }
             (BoardState::Complete, Ok(Message::Ack { .. })) => BoardState::Restarting(now),
             (BoardState::Complete, Ok(Message::Error(_))) => self.again(
@@ -605,6 +605,7 @@ impl Update {
                 "refused the swap: the image it holds does not check".into(),
             ),
             (BoardState::Restarting(_), Ok(Message::Service(Service::FwRel { firmware, .. }))) => {
+                let firmware = *firmware;
                 self.targets[b].firmware = Some(firmware);
                 // An image that states no release is judged by its swap's
                 // ACK, the restart and the board answering.
@@ -700,6 +701,11 @@ mod tests {
     use crate::app::frame::FrameType;
     use alloc::vec;
 
+    /// Hands `u` an answer, owned as tests build them.
+    fn answer(u: &mut Update, now: Instant, a: Result<Message, String>) {
+        u.on_answer(now, a.as_ref().map_err(String::as_str));
+    }
+
     const NEW: Release = Release { major: 2, minor: 1 };
 
     fn board() -> Address {
@@ -750,7 +756,7 @@ mod tests {
         let r = u.poll(0).unwrap();
         assert!(matches!(r.message, Message::Service(Service::RfuHeader(_))));
         assert_eq!(u.poll(0), None, "waits for the answer");
-        u.on_answer(0, ack(0x0c));
+        answer(&mut u, 0, ack(0x0c));
         let mut t = 0;
         for n in 0..3 {
             let r = u.poll(t).unwrap();
@@ -767,7 +773,7 @@ mod tests {
             Message::Service(Service::RfuStatusGet { campaign: 9 })
         ));
         let status = held(RfuState::Receiving, 0b101);
-        u.on_answer(t, Ok(Message::Service(Service::RfuStatus(status))));
+        answer(&mut u, t, Ok(Message::Service(Service::RfuStatus(status))));
         let r = u.poll(t).unwrap();
         assert!(!r.broadcast);
         assert!(matches!(
@@ -781,19 +787,20 @@ mod tests {
             Message::Service(Service::RfuStatusGet { .. })
         ));
         let status = held(RfuState::Complete, 0b111);
-        u.on_answer(t, Ok(Message::Service(Service::RfuStatus(status))));
+        answer(&mut u, t, Ok(Message::Service(Service::RfuStatus(status))));
         let r = u.poll(t).unwrap();
         assert!(matches!(
             r.message,
             Message::Service(Service::RfuSwap { campaign: 9, .. })
         ));
-        u.on_answer(t, ack(0x0e));
+        answer(&mut u, t, ack(0x0e));
         assert_eq!(u.poll(t), None);
         assert_eq!(u.poll_timeout(), Some(t + c.restart));
         t += c.restart;
         let r = u.poll(t).unwrap();
         assert_eq!(r.message, Message::Service(Service::FwRelGet));
-        u.on_answer(
+        answer(
+            &mut u,
             t,
             Ok(Message::Service(Service::FwRel {
                 firmware: NEW,
@@ -817,9 +824,9 @@ mod tests {
         )
         .unwrap();
         u.poll(0).unwrap();
-        u.on_answer(0, ack(0x0c));
+        answer(&mut u, 0, ack(0x0c));
         u.poll(0).unwrap();
-        u.on_answer(0, ack(0x0c));
+        answer(&mut u, 0, ack(0x0c));
         let r = u.poll(0).unwrap();
         assert!(matches!(
             r.message,
@@ -832,7 +839,7 @@ mod tests {
                 r.message,
                 Message::Service(Service::RfuAbort { campaign: 1 })
             );
-            u.on_answer(1_000_000, ack(0x12));
+            answer(&mut u, 1_000_000, ack(0x12));
         }
         assert_eq!(u.poll(1_000_000), None);
         assert!(u.is_done());
@@ -855,7 +862,7 @@ mod tests {
         for n in 0..=c.silences {
             let r = u.poll(t).expect("the header again");
             assert!(matches!(r.message, Message::Service(Service::RfuHeader(_))));
-            u.on_answer(t, Err("did not answer 3 times".into()));
+            answer(&mut u, t, Err("did not answer 3 times".into()));
             if n < c.silences {
                 assert_eq!(u.poll(t), None, "backs off");
                 let wait = c.backoff << n;

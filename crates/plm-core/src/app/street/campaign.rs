@@ -2,7 +2,7 @@
 //! beside the street's other work (the sweep stops for it and comes back
 //! after), with pause, cancel, and resume from what was saved.
 
-use super::{Street, StreetJob};
+use super::Street;
 use crate::app::concentrator::{Concentrator, Happening};
 use crate::app::frame::Address;
 use crate::app::rfu::image;
@@ -10,14 +10,13 @@ use crate::app::service::Release;
 use crate::app::update::{BoardState, Update, UpdateConfig};
 use crate::app::Run;
 use crate::time::Instant;
-use alloc::boxed::Box;
 use alloc::string::String;
 use alloc::vec::Vec;
 
 /// A campaign under way (or over, its results kept until dismissed).
 pub struct Campaign {
     /// The engine, run on the concentrator.
-    run: Run<StreetJob>,
+    run: Run<Update>,
     /// Paused by the user: nothing more is sent until resumed.
     pub paused: bool,
     /// When it started or resumed, on the driver's clock.
@@ -31,17 +30,7 @@ pub struct Campaign {
 impl Campaign {
     /// The engine: its boards, progress and report.
     pub fn update(&self) -> &Update {
-        match self.run.job() {
-            StreetJob::Update(u) => u,
-            _ => unreachable!("a campaign runs an update"),
-        }
-    }
-
-    fn update_mut(&mut self) -> &mut Update {
-        match self.run.job_mut() {
-            StreetJob::Update(u) => u,
-            _ => unreachable!("a campaign runs an update"),
-        }
+        self.run.job()
     }
 
     /// When the engine has something to send again, if it waits for time.
@@ -58,7 +47,9 @@ impl<R> Street<R> {
 
     /// Whether an update has the line (started and not over).
     pub(super) fn updating(&self) -> bool {
-        self.campaign.as_ref().is_some_and(|c| !c.update().is_done())
+        self.campaign
+            .as_ref()
+            .is_some_and(|c| !c.update().is_done())
     }
 
     /// Starts updating `targets` with `image` (reporting release `stated`
@@ -84,7 +75,12 @@ impl<R> Street<R> {
     }
 
     /// Goes on with a campaign saved by [`Update::save`].
-    pub fn resume_update(&mut self, now: Instant, image: Vec<u8>, saved: &[u8]) -> Result<(), String> {
+    pub fn resume_update(
+        &mut self,
+        now: Instant,
+        image: Vec<u8>,
+        saved: &[u8],
+    ) -> Result<(), String> {
         let u = Update::resume(image, saved, now)?;
         self.begin(now, u);
         Ok(())
@@ -94,7 +90,7 @@ impl<R> Street<R> {
         let sweep_was_on = self.sweep.on;
         self.set_sweep(now, false);
         self.campaign = Some(Campaign {
-            run: Run::new(StreetJob::Update(Box::new(update))),
+            run: Run::new(update),
             paused: false,
             since: now,
             ended: None,
@@ -115,7 +111,7 @@ impl<R> Street<R> {
     /// release; boards swapped already finish.
     pub fn cancel_update(&mut self) {
         if let Some(c) = self.campaign.as_mut() {
-            c.update_mut().abort();
+            c.run.job_mut().abort();
             c.paused = false;
             self.out.campaign = true;
         }

@@ -242,6 +242,11 @@ mod tests {
     use crate::app::message::Message;
     use crate::app::service::Release;
 
+    /// Hands `u` an answer, owned as tests build them.
+    fn answer(u: &mut Update, now: Instant, a: Result<Message, String>) {
+        u.on_answer(now, a.as_ref().map_err(String::as_str));
+    }
+
     #[test]
     fn a_campaign_saved_mid_way_resumes_where_it_was() {
         let image: Vec<u8> = (0..1_000u32).map(|i| (i * 3) as u8).collect();
@@ -249,9 +254,10 @@ mod tests {
         let v = Release { major: 3, minor: 2 };
         let mut u = Update::new(7, v, image.clone(), &a, UpdateConfig::default()).unwrap();
         u.poll(0).unwrap();
-        u.on_answer(0, Err("silent".into()));
+        answer(&mut u, 0, Err("silent".into()));
         u.poll(0).unwrap();
-        u.on_answer(
+        answer(
+            &mut u,
             0,
             Ok(Message::Ack {
                 frame_type: crate::app::frame::FrameType::Service,
