@@ -82,8 +82,12 @@ impl StreetSession {
     /// A session over `transport` with `conc` (a board USART or a bare
     /// modem concentrator, as the connection profile says).
     pub fn new(transport: Box<dyn Transport>, conc: Concentrator) -> Self {
+        Self::over(Some(transport), conc)
+    }
+
+    fn over(transport: Option<Box<dyn Transport>>, conc: Concentrator) -> Self {
         StreetSession {
-            drive: Driver::new(Some(transport)),
+            drive: Driver::new(transport),
             street: Street::new(&conc),
             conc,
             decoder: Decoder::new(Dialect::St7580, Source::Any),
@@ -95,12 +99,7 @@ impl StreetSession {
 
     /// A session with nothing connected (another profile is in use).
     pub fn idle() -> Self {
-        let mut s = Self::new(
-            Box::new(crate::transport::sim::SimTransport::new(1, 57_600, 0)),
-            Concentrator::usart(RequesterConfig::default()),
-        );
-        s.drive.transport = None;
-        s
+        Self::over(None, Concentrator::usart(RequesterConfig::default()))
     }
 
     /// A session through a concentrator board's USART.
@@ -235,13 +234,10 @@ impl StreetSession {
     /// Sends any request from a view; `reply` gets the answer. Refused
     /// before anything is sent when the board would refuse it.
     pub fn request(&mut self, request: Request, reply: StreetReply) -> Result<(), String> {
-        request.message.validate()?;
-        if let Some(why) = self.down() {
-            self.street.refuse(reply, why);
-            return Ok(());
-        }
         let now = self.now();
-        self.street.request(&mut self.conc, now, request, reply)?;
+        let down = self.down();
+        self.street
+            .request(&mut self.conc, now, request, reply, down)?;
         driver::flush(self, now);
         Ok(())
     }

@@ -342,17 +342,22 @@ impl<R> Street<R> {
     }
 
     /// Sends any request; its outcome comes back with `reply`
-    /// ([`Changes::replies`]). Refused before anything is sent when the
-    /// board would refuse it.
+    /// ([`Changes::replies`]): at once, failed with `down`, when the cable
+    /// is out. Refused before anything is sent when the board would
+    /// refuse it.
     pub fn request(
         &mut self,
         conc: &mut Concentrator,
         now: Instant,
         request: Request,
         reply: R,
+        down: Option<String>,
     ) -> Result<(), String> {
         request.message.validate()?;
-        self.submit(conc, now, request, Purpose::View(reply));
+        match down {
+            Some(why) => self.out.replies.push((reply, Err(why))),
+            None => self.submit(conc, now, request, Purpose::View(reply)),
+        }
         Ok(())
     }
 
@@ -559,11 +564,6 @@ impl<R> Street<R> {
         }
     }
 
-    /// Tells the caller's request `reply` failed before it was sent
-    /// (the cable is out), with the other outcomes.
-    pub fn refuse(&mut self, reply: R, why: String) {
-        self.out.replies.push((reply, Err(why)));
-    }
 
     /// What an application event means for the fleet and the callers'
     /// requests; `job`, `update`: the discovery's or the round's, or the

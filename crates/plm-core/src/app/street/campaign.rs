@@ -169,16 +169,12 @@ impl<R> Street<R> {
         }
         c.ended = Some(now);
         let sweep = core::mem::take(&mut c.sweep_was_on);
-        let u = c.update();
+        let u = c.run.job();
         let stated = u.header().release();
-        let done: Vec<(Address, Option<Release>)> = u
-            .boards()
-            .enumerate()
-            .filter(|(_, (_, s))| **s == BoardState::Done)
-            .map(|(i, (a, _))| (a, stated.or(u.firmware(i))))
-            .collect();
-        for (a, release) in done {
-            if let (Some(d), Some(r)) = (self.lamp(a).discovered.as_mut(), release) {
+        for (i, (a, s)) in u.boards().enumerate() {
+            let release = stated.or(u.firmware(i));
+            let lamp = self.fleet.get_mut(&a).and_then(|l| l.discovered.as_mut());
+            if let (BoardState::Done, Some(d), Some(r)) = (s, lamp, release) {
                 d.firmware = r;
             }
         }
