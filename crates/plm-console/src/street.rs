@@ -15,7 +15,7 @@ use crate::driver::{self, earliest, AnyEngine, Budget, Driver, Layer};
 use crate::throttle::Throttle;
 use crate::transport::{LinkState, Transport};
 use plm_core::app::service::Discovered;
-use plm_core::app::street::{Line, Street};
+use plm_core::app::street::Street;
 use plm_core::app::{Address, Concentrator, Happening, Message, Request, RequesterConfig};
 use plm_core::decode::{Decoded, Decoder};
 use plm_core::link::host;
@@ -127,14 +127,6 @@ impl StreetSession {
             })
     }
 
-    /// Why nothing can be sent now, if the cable is out.
-    fn down(&self) -> Option<String> {
-        match self.state() {
-            LinkState::Disconnected(why) => Some(why),
-            _ => None,
-        }
-    }
-
     /// The transport's clock.
     pub fn now(&self) -> Instant {
         self.drive.now()
@@ -212,20 +204,15 @@ impl StreetSession {
 
     /// Reads every parameter of one lamp now.
     pub fn read(&mut self, address: Address) {
-        if self.down().is_none() {
-            let now = self.now();
-            self.street.read(&mut self.conc, now, address);
-            driver::flush(self, now);
-        }
+        let now = self.now();
+        self.street.read(&mut self.conc, now, address);
+        driver::flush(self, now);
     }
 
     /// Dims one lamp, or every lamp with `None` (broadcast). Refused
     /// before anything is sent when the value is not 0-100.
     pub fn dim(&mut self, target: Option<Address>, level: u8) -> Result<(), String> {
         let now = self.now();
-        if self.down().is_some() {
-            return Message::Hid(plm_core::app::Hid::Dimming(level)).validate();
-        }
         self.street.dim(&mut self.conc, now, target, level)?;
         driver::flush(self, now);
         Ok(())
@@ -235,24 +222,33 @@ impl StreetSession {
     /// before anything is sent when the board would refuse it.
     pub fn request(&mut self, request: Request, reply: StreetReply) -> Result<(), String> {
         let now = self.now();
-        let down = self.down();
-        self.street
-            .request(&mut self.conc, now, request, reply, down)?;
+        self.street.request(&mut self.conc, now, request, reply)?;
         driver::flush(self, now);
         Ok(())
     }
 
-    /// What the line allows the street now: down with the cable out;
-    /// through a bare modem, held while the views are to be drawn or a
-    /// draw waits to be painted ([`StreetSession::draw_first`]).
-    fn line(&self) -> Line {
-        if self.down().is_some() {
-            Line::Down
-        } else if self.hold.pending() || self.draw_first() {
-            Line::Held
-        } else {
-            Line::Free
+    /// Whether the street's next requests wait for the page: through a
+    /// bare modem, while the views are to be drawn or a draw waits to be
+    /// painted ([`StreetSession::draw_first`]).
+    fn holds(&self) -> bool {
+        self.hold.pending() || self.draw_first()
+    }
+
+    /// Tells the street whether the cable is out, and fails what was under
+    /// way if it is.
+    fn follow_link(&mut self) {
+        let down = match self.state() {
+            LinkState::Disconnected(why) => Some(why),
+            LinkState::Connected => None,
+        };
+        if let Some(why) = &down {
+            if self.conc.requester().pending() > 0 {
+                self.conc.abort_all(why);
+                let now = self.now();
+                driver::flush(self, now);
+            }
         }
+        self.street.set_down(down);
     }
 
     /// Whether the street's next requests are to wait for its views to
@@ -308,13 +304,7 @@ impl StreetSession {
     /// Lets the transport's time catch up with the page's clock.
     pub fn tick(&mut self, page_us: f64, budget: Budget) -> StreetTick {
         self.hold.settle();
-        if let Some(why) = self.down() {
-            if self.conc.requester().pending() > 0 {
-                self.conc.abort_all(&why);
-                let now = self.now();
-                driver::flush(self, now);
-            }
-        }
+        self.follow_link();
         driver::tick(self, page_us, budget);
         self.hand_out(page_us)
     }
@@ -325,6 +315,7 @@ impl StreetSession {
         let mut t = start;
         while t < target && self.drive.transport.is_some() {
             self.hold.settle();
+            self.follow_link();
             driver::run_within(self, t, target, Budget::UNLIMITED);
             t = self.now();
         }
@@ -337,7 +328,7 @@ impl StreetSession {
     pub fn next_due(&self) -> Option<Instant> {
         earliest([
             self.conc.poll_timeout(),
-            self.street.poll_timeout(self.now(), self.line()),
+            self.street.poll_timeout(self.now(), self.holds()),
             self.drive.transport.as_ref().and_then(|t| t.next_event()),
         ])
     }
@@ -395,8 +386,8 @@ impl Layer for StreetSession {
     fn at(&mut self, now: Instant) {
         // Painted already (or no page paints: a test's own loop).
         self.hold.settle();
-        let line = self.line();
-        self.street.pump(&mut self.conc, now, line);
+        let hold = self.holds();
+        self.street.pump(&mut self.conc, now, hold);
         if self.street.is_held() && !self.hold.pending() {
             self.out.show = self.shown.show_after(true, self.drive.tick_at(), 0.0);
             self.hold.begin();

@@ -5,7 +5,7 @@
 //! session and `plm board status all` run the same machine.
 
 use plm_core::app::job::Router;
-use plm_core::app::street::{Line, Street};
+use plm_core::app::street::Street;
 use plm_core::app::update::BoardState;
 use plm_core::app::{Concentrator, Happening, LampState, Release, RequesterConfig};
 use plm_core::time::{Duration, Instant, MS};
@@ -21,13 +21,13 @@ struct For<'a>(&'a mut Street<()>);
 
 impl Router for For<'_> {
     fn pump(&mut self, conc: &mut Concentrator, now: Instant) {
-        self.0.pump(conc, now, Line::Free)
+        self.0.pump(conc, now, false)
     }
     fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening) {
         self.0.handle(conc, now, h.clone())
     }
     fn poll_timeout(&self, now: Instant) -> Option<Instant> {
-        self.0.poll_timeout(now, Line::Free)
+        self.0.poll_timeout(now, false)
     }
     fn is_done(&self) -> bool {
         false

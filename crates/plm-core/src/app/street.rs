@@ -54,18 +54,6 @@ pub struct Sweep {
     pub in_slots: usize,
 }
 
-/// What the line allows the street at a [`Street::pump`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Line {
-    /// Requests go as they come.
-    Free,
-    /// The driver's page draws: the discovery's or the sweep's next
-    /// request, and the views' requests, wait (the update goes on).
-    Held,
-    /// The cable is out: the update waits (its state is kept).
-    Down,
-}
-
 /// What changed since [`Street::take`] was last called.
 #[derive(Debug)]
 pub struct Changes<R> {
@@ -170,6 +158,8 @@ pub struct Street<R> {
     /// What each request under way is for (a few at a time: a list).
     purposes: Vec<(RequestId, Purpose<R>)>,
     campaign: Option<Campaign>,
+    /// Why nothing can be sent (the cable is out), if so.
+    down: Option<String>,
     out: Changes<R>,
 }
 
@@ -189,8 +179,17 @@ impl<R> Street<R> {
             held: Vec::new(),
             purposes: Vec::new(),
             campaign: None,
+            down: None,
             out: Changes::default(),
         }
+    }
+
+    /// The cable is out (`why`), or back (`None`): until it is back, what
+    /// is asked is not sent (a caller's request fails with `why` at once,
+    /// a read or a dimming is dropped) and the update waits, its state
+    /// kept.
+    pub fn set_down(&mut self, why: Option<String>) {
+        self.down = why;
     }
 
     /// Whether it runs through a bare modem.
@@ -229,8 +228,8 @@ impl<R> Street<R> {
         })
     }
 
-    /// Whether the discovery's or the sweep's next request waits for the
-    /// line ([`Line::Held`]).
+    /// Whether the discovery's or the sweep's next request is held back
+    /// ([`Street::pump`]'s `hold`).
     pub fn is_held(&self) -> bool {
         self.job.as_ref().is_some_and(Run::is_held)
     }
@@ -327,6 +326,9 @@ impl<R> Street<R> {
     ) -> Result<(), String> {
         let m = Message::Hid(Hid::Dimming(level));
         m.validate()?;
+        if self.down.is_some() {
+            return Ok(());
+        }
         match target {
             Some(a) => self.submit(conc, now, Request::to(a, m), Purpose::Dim(a, level)),
             None => {
@@ -342,26 +344,27 @@ impl<R> Street<R> {
     }
 
     /// Sends any request; its outcome comes back with `reply`
-    /// ([`Changes::replies`]): at once, failed with `down`, when the cable
-    /// is out. Refused before anything is sent when the board would
-    /// refuse it.
+    /// ([`Changes::replies`]). Refused before anything is sent when the
+    /// board would refuse it.
     pub fn request(
         &mut self,
         conc: &mut Concentrator,
         now: Instant,
         request: Request,
         reply: R,
-        down: Option<String>,
     ) -> Result<(), String> {
         request.message.validate()?;
-        match down {
-            Some(why) => self.out.replies.push((reply, Err(why))),
-            None => self.submit(conc, now, request, Purpose::View(reply)),
-        }
+        self.submit(conc, now, request, Purpose::View(reply));
         Ok(())
     }
 
     fn submit(&mut self, conc: &mut Concentrator, now: Instant, request: Request, p: Purpose<R>) {
+        if let Some(why) = &self.down {
+            if let Purpose::View(reply) = p {
+                self.out.replies.push((reply, Err(why.clone())));
+            }
+            return;
+        }
         // Lamps answer in their slots: a frame sent now would collide.
         if self.slots_open(now) {
             self.held.push((request, p));
@@ -379,9 +382,10 @@ impl<R> Street<R> {
 
     /// The street's work at `now`, after each turn of its driver: the
     /// discovery's, the sweep's and the update's next requests, and the
-    /// views' requests that waited, as `line` allows.
-    pub fn pump(&mut self, conc: &mut Concentrator, now: Instant, line: Line) {
-        let hold = line == Line::Held;
+    /// callers' requests that waited. With `hold` (its driver's page
+    /// draws), the discovery's or the sweep's next request and the
+    /// callers' wait; the update goes on.
+    pub fn pump(&mut self, conc: &mut Concentrator, now: Instant, hold: bool) {
         self.run_discovery(conc, now, hold);
         if !hold && !self.slots_open(now) {
             for (request, p) in core::mem::take(&mut self.held) {
@@ -389,16 +393,15 @@ impl<R> Street<R> {
             }
         }
         self.run_sweep(conc, now, hold);
-        if line != Line::Down {
+        if self.down.is_none() {
             self.run_update(conc, now);
         }
     }
 
-    /// The next instant [`Street::pump`] has something to do, as `line`
-    /// allows (what it holds goes once the line is free, which its driver
+    /// The next instant [`Street::pump`] has something to do, with its
+    /// `hold` (what it holds goes once it is released, which its driver
     /// knows).
-    pub fn poll_timeout(&self, now: Instant, line: Line) -> Option<Instant> {
-        let hold = line == Line::Held;
+    pub fn poll_timeout(&self, now: Instant, hold: bool) -> Option<Instant> {
         let job = self.job.as_ref().filter(|j| !(hold && j.is_held()));
         let held = !self.held.is_empty() && !self.slots_open(now) && !hold;
         let mut t = job.and_then(|j| j.poll_timeout());
@@ -632,14 +635,14 @@ impl<R> Street<R> {
 /// always free), until it is idle.
 impl<R> Router for Street<R> {
     fn pump(&mut self, conc: &mut Concentrator, now: Instant) {
-        Street::pump(self, conc, now, Line::Free)
+        Street::pump(self, conc, now, false)
     }
     fn handle(&mut self, conc: &mut Concentrator, now: Instant, h: &Happening) {
         Street::handle(self, conc, now, h.clone())
     }
     fn poll_timeout(&self, now: Instant) -> Option<Instant> {
         // The next sweep is not waited for: the street is idle until then.
-        let next = Street::poll_timeout(self, now, Line::Free);
+        let next = Street::poll_timeout(self, now, false);
         next.filter(|_| !self.is_idle())
     }
     fn is_done(&self) -> bool {
