@@ -128,7 +128,7 @@ pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result
         "plm board: {} lamp(s) read, {silent} silent, in {:.1} s; {} heard in their slot",
         n - silent,
         started.elapsed().as_secs_f64(),
-        street.sweep().in_slots
+        street.in_slots()
     );
     Ok(if n == 0 || silent > 0 {
         exit::FAILED

@@ -117,9 +117,11 @@ impl Console {
     /// Where the RESETN-on-DTR setting of the port in use is kept.
     fn resetn_key(&self) -> String {
         let port = self.conn.port.get_untracked();
+        // The port's name without what follows it in brackets.
+        let name = port.as_bytes().windows(2).position(|w| w == b" (");
         format!(
             "plm-console.resetn-on-dtr.{}",
-            port.split(" (").next().unwrap_or("")
+            &port[..name.unwrap_or(port.len())]
         )
     }
 

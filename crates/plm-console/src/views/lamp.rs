@@ -303,7 +303,7 @@ pub fn LampPanel(focus: RwSignal<Option<u64>>) -> impl IntoView {
                         }))>
                             {html(Box::new(move || {
                                 street.version.track();
-                                let simulated = street.port.with(|p| p.contains("simulated"));
+                                let simulated = street.port.with(|p| crate::fleet::has_text(p, "simulated"));
                                 street.with_fleet(|f| state_html(f.get(&address), simulated))
                             }))}
                         </div>
@@ -364,7 +364,7 @@ pub fn LampPanel(focus: RwSignal<Option<u64>>) -> impl IntoView {
                             })}
                         </div>
                         {text_input("lamp-params", "payload hex", "32 bytes, hex", None, params)}
-                        {move || (street.port.get().contains("simulated")).then(|| view! {
+                        {move || street.port.with(|p| crate::fleet::has_text(p, "simulated")).then(|| view! {
                             <div class="form-row sim-actions">
                                 <span class="muted">"Simulator:"</span>
                                 {button("lamp-sim-fail", "Break lamp", "", move || sim(LampAction::Fail))}

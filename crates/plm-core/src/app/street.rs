@@ -50,8 +50,6 @@ pub struct Sweep {
     pub total: usize,
     /// Completed rounds.
     pub rounds: u64,
-    /// Lamps heard in their slot in the last completed round.
-    pub in_slots: usize,
 }
 
 /// What changed since [`Street::take`] was last called.
@@ -150,6 +148,8 @@ pub struct Street<R> {
     /// A discovery has just ended: the next round needs no probe.
     just_found: bool,
     sweep: Sweep,
+    /// Lamps heard in their slot in the last round.
+    in_slots: usize,
     next_sweep: Option<Instant>,
     fleet: BTreeMap<Address, Lamp>,
     /// Requests that wait for the round's slots to close or the page's
@@ -174,6 +174,7 @@ impl<R> Street<R> {
             look_for_new: false,
             just_found: false,
             sweep: Sweep::default(),
+            in_slots: 0,
             next_sweep: None,
             fleet: BTreeMap::new(),
             held: Vec::new(),
@@ -205,6 +206,12 @@ impl<R> Street<R> {
     /// The sweep's progress.
     pub fn sweep(&self) -> Sweep {
         self.sweep
+    }
+
+    /// Lamps heard in their slot in the sweep's last round (the others
+    /// were asked alone).
+    pub fn in_slots(&self) -> usize {
+        self.in_slots
     }
 
     /// What changed and is not taken yet.
@@ -521,7 +528,7 @@ impl<R> Street<R> {
         if let (_, Some(StreetJob::Round(round))) = self.pump_job(conc, now, hold) {
             self.sweep.rounds += 1;
             self.sweep.total = 0;
-            self.sweep.in_slots = round.in_slots();
+            self.in_slots = round.in_slots();
             // Sooner when a dimming of every lamp asked for it.
             let pause = now + SWEEP_PAUSE;
             self.next_sweep = Some(self.next_sweep.map_or(pause, |t| t.min(pause)));
@@ -566,7 +573,6 @@ impl<R> Street<R> {
             _ => {}
         }
     }
-
 
     /// What an application event means for the fleet and the callers'
     /// requests; `job`, `update`: the discovery's or the round's, or the
