@@ -327,7 +327,10 @@ mod tests {
     /// longer than it never; UTF-8 is matched whole.
     #[test]
     fn a_text_holds_its_parts() {
-        assert!(has_text("ST7580 concentrator (simulated, 12 lamps)", "simulated"));
+        assert!(has_text(
+            "ST7580 concentrator (simulated, 12 lamps)",
+            "simulated"
+        ));
         assert!(has_text("abc", "") && has_text("abc", "abc") && has_text("abc", "c"));
         assert!(!has_text("ab", "abc") && !has_text("simulate", "simulated"));
         assert!(has_text("Pont-l’Évêque (COM3)", "Évê"));

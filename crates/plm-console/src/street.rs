@@ -451,11 +451,11 @@ mod tests {
     /// A street of 50: discovery, the sweep reading every lamp, dimming
     /// one and all (broadcast), every clock set, a failed lamp and an
     /// unreachable one raised as alerts: through the board's USART and
-    /// through a bare modem. The discovery and the sweep's rounds are
-    /// plm-core's jobs run by plm-core's `job::Run`, the code `plm board
-    /// discover` and plm-sim's `StreetDriver` run them with.
+    /// through a bare modem. All of it is plm-core's `Street`, the machine
+    /// `plm board status all` and plm-sim's `tests/street_machine.rs`
+    /// run, here on the console's driver.
     #[test]
-    fn a_street_is_found_read_dimmed_and_watched_by_plm_cores_run() {
+    fn a_street_is_found_read_dimmed_and_watched_by_plm_cores_street() {
         for via in [Attach::Board, Attach::Modem] {
             let mut s = session(via);
             s.discover();
