@@ -9,12 +9,12 @@
 
 mod campaign;
 
-pub use plm_core::app::street::{Alert, Campaign, Lamp, Sample, Sweep, HISTORY};
+pub use plm_core::app::street::{Alert, Campaign, Lamp, Lamps, Sample, Sweep, HISTORY};
 
 use crate::driver::{self, earliest, AnyEngine, Budget, Driver, Layer};
 use crate::throttle::Throttle;
 use crate::transport::{LinkState, Transport};
-use plm_core::app::service::Discovered;
+use plm_core::app::service::{Clock, Discovered};
 use plm_core::app::street::Street;
 use plm_core::app::{Address, Concentrator, Happening, Message, Request, RequesterConfig};
 use plm_core::decode::{Decoded, Decoder};
@@ -209,11 +209,19 @@ impl StreetSession {
         driver::flush(self, now);
     }
 
-    /// Dims one lamp, or every lamp with `None` (broadcast). Refused
-    /// before anything is sent when the value is not 0-100.
-    pub fn dim(&mut self, target: Option<Address>, level: u8) -> Result<(), String> {
+    /// Dims `lamps` ([`Street::dim`]). Refused before anything is sent
+    /// when the value is not 0-100.
+    pub fn dim(&mut self, lamps: Lamps<'_>, level: u8) -> Result<(), String> {
         let now = self.now();
-        self.street.dim(&mut self.conc, now, target, level)?;
+        self.street.dim(&mut self.conc, now, lamps, level)?;
+        driver::flush(self, now);
+        Ok(())
+    }
+
+    /// Sets the clocks of `lamps` to `clock`.
+    pub fn set_clock(&mut self, lamps: Lamps<'_>, clock: Clock) -> Result<(), String> {
+        let now = self.now();
+        self.street.set_clock(&mut self.conc, now, lamps, clock)?;
         driver::flush(self, now);
         Ok(())
     }
@@ -474,7 +482,7 @@ mod tests {
             }
             let a3 = street_address(3);
             let full = s.fleet()[&a3].ballast.unwrap().lamp_power;
-            s.dim(Some(a3), 20).unwrap();
+            s.dim(Lamps::These(&[a3]), 20).unwrap();
             run(&mut s, 10 * S);
             let dimmed = s.fleet()[&a3].ballast.unwrap().lamp_power;
             assert!(
@@ -483,8 +491,11 @@ mod tests {
             );
             assert_eq!(s.fleet()[&a3].dimming, Some(20));
 
-            assert!(s.dim(None, 101).is_err(), "refused before anything is sent");
-            s.dim(None, 60).unwrap();
+            assert!(
+                s.dim(Lamps::All, 101).is_err(),
+                "refused before anything is sent"
+            );
+            s.dim(Lamps::All, 60).unwrap();
             run(&mut s, 60 * S);
             assert!(s.fleet().values().all(|l| l.dimming == Some(60)));
             let full = s.fleet()[&street_address(40)].ballast.unwrap().lamp_power;

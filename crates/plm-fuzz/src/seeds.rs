@@ -33,7 +33,7 @@ pub fn saved_campaign(steps: u32) -> Vec<u8> {
     let mut now = 0;
     for _ in 0..steps {
         if u.poll(now).is_some() {
-            u.on_answer(now, Err("silent".into()));
+            u.on_answer(now, Err("silent"));
         }
         now += 250_000;
     }

@@ -206,7 +206,7 @@ pub fn saved_campaign(data: &[u8]) {
             break;
         }
         if update.poll(now).is_some() {
-            update.on_answer(now, Err("silent".into()));
+            update.on_answer(now, Err("silent"));
         }
         let _ = (update.bytes_sent(), update.time_left(now), update.report());
         now += 100 * MS;

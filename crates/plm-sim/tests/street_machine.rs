@@ -5,9 +5,11 @@
 //! session and `plm board status all` run the same machine.
 
 use plm_core::app::job::Router;
-use plm_core::app::street::Street;
+use plm_core::app::street::{Lamps, Street};
 use plm_core::app::update::BoardState;
-use plm_core::app::{Concentrator, Happening, LampState, Release, RequesterConfig};
+use plm_core::app::{
+    Clock, Concentrator, Happening, LampState, Message, Release, Request, RequesterConfig, Service,
+};
 use plm_core::time::{Duration, Instant, MS};
 use plm_sim::board::street_address;
 use plm_sim::rfu::firmware_image;
@@ -46,7 +48,8 @@ fn street(lamps: usize, via: Attach) -> (StreetDriver, Street<()>) {
 }
 
 /// A street of 60 found and read in one go (discovery, then the sweep's
-/// first round, in slots), one lamp dimmed and read again, two lamps
+/// first round, in slots), one lamp dimmed and read again, the clocks of
+/// a selection set (one read back by a caller's request), two lamps
 /// updated while the sweep waits (it comes back after, the fleet showing
 /// the new release), and a lamp failing raised as an alert by a later
 /// round.
@@ -74,8 +77,8 @@ fn plm_cores_street_finds_reads_dims_updates_and_watches_a_street() {
         let a = street_address(7);
         let full = s.fleet()[&a].ballast.unwrap().lamp_power;
         let now = d.now();
-        s.dim(&mut d.conc, now, Some(a), 20).unwrap();
-        assert!(s.dim(&mut d.conc, now, None, 101).is_err());
+        s.dim(&mut d.conc, now, Lamps::These(&[a]), 20).unwrap();
+        assert!(s.dim(&mut d.conc, now, Lamps::All, 101).is_err());
         assert!(d.drive(&mut s, 30 * S), "{via:?}");
         let lamp = &s.fleet()[&a];
         assert_eq!(lamp.dimming, Some(20), "{via:?}");
@@ -83,6 +86,30 @@ fn plm_cores_street_finds_reads_dims_updates_and_watches_a_street() {
             lamp.ballast.unwrap().lamp_power < full,
             "{via:?}: read again"
         );
+
+        // The clocks of a selection set, one read back.
+        let noon = Clock {
+            hours: 12,
+            minutes: 0,
+            seconds: 0,
+        };
+        let picked = [street_address(3), street_address(4)];
+        let now = d.now();
+        s.set_clock(&mut d.conc, now, Lamps::These(&picked), noon)
+            .unwrap();
+        assert!(d.drive(&mut s, 30 * S), "{via:?}");
+        s.take();
+        let get = Request::to(picked[1], Message::Service(Service::ClockGet));
+        let now = d.now();
+        s.request(&mut d.conc, now, get, ()).unwrap();
+        assert!(d.drive(&mut s, 30 * S), "{via:?}");
+        match &s.take().replies[..] {
+            [((), Ok(Message::Service(Service::ClockNow(c))))] => assert!(
+                c.seconds_of_day().abs_diff(noon.seconds_of_day()) < 10,
+                "{via:?}: {c}"
+            ),
+            other => panic!("{via:?}: {other:?}"),
+        }
 
         let new = Release { major: 1, minor: 7 };
         let targets = [street_address(1), street_address(2)];

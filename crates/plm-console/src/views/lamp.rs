@@ -8,7 +8,7 @@ use super::widgets::{button, escape, html, on_event, signal, text_input};
 use crate::clock::computer_clock;
 use crate::fleet::{dimming_value, key_address};
 use crate::stores::use_console;
-use crate::street::{Lamp, Sample};
+use crate::street::{Lamp, Lamps, Sample};
 use crate::transport::LampAction;
 use leptos::prelude::*;
 use plm_core::app::service::{self, Service};
@@ -316,8 +316,8 @@ pub fn LampPanel(focus: RwSignal<Option<u64>>) -> impl IntoView {
                             {button("lamp-dim", "Dim", "", move || {
                                 match dimming_value(&level.get_untracked()) {
                                     Ok(v) => {
-                                        let a = focus.get_untracked().map(key_address);
-                                        let r = street.act(|s| s.dim(a, v));
+                                        let Some(a) = focus.get_untracked().map(key_address) else { return };
+                                        let r = street.act(|s| s.dim(Lamps::These(&[a]), v));
                                         note.set(Some(match r { Ok(()) => format!("dimming {v} % sent"), Err(e) => format!("nothing sent: {e}") }));
                                     }
                                     Err(e) => note.set(Some(e)),

@@ -14,9 +14,9 @@ use super::widgets::{
 use crate::clock::computer_clock;
 use crate::fleet::{self, dimming_value, key_address, row_key, Row, COLUMNS};
 use crate::stores::use_console;
+use crate::street::Lamps;
 use leptos::prelude::*;
-use plm_core::app::service::Service;
-use plm_core::app::{Address, Message, Request};
+use plm_core::app::Address;
 
 /// The view.
 #[component]
@@ -243,8 +243,8 @@ fn GroupActions(
             Err(e) => return message.set(Some(e)),
         };
         let r = street.act(|s| match &targets {
-            None => s.dim(None, v),
-            Some(list) => list.iter().try_for_each(|a| s.dim(Some(*a), v)),
+            None => s.dim(Lamps::All, v),
+            Some(list) => s.dim(Lamps::These(list), v),
         });
         message.set(Some(match (r, targets) {
             (Err(e), _) => format!("nothing sent: {e}"),
@@ -254,12 +254,7 @@ fn GroupActions(
     };
     let set_clocks = move || {
         let c = computer_clock();
-        let r = street.act(|s| {
-            s.request(
-                Request::all(Message::Service(Service::ClockSet(c))),
-                Box::new(|_| {}),
-            )
-        });
+        let r = street.act(|s| s.set_clock(Lamps::All, c));
         message.set(Some(match r {
             Ok(()) => format!("clock {c} sent to every lamp (broadcast)"),
             Err(e) => format!("nothing sent: {e}"),
@@ -286,11 +281,7 @@ fn GroupActions(
                 Box::new(move || {
                     let c = computer_clock();
                     let list = selected.get_untracked();
-                    let r = street.act(|s| {
-                        list.iter().try_for_each(|a| {
-                            s.request(Request::to(*a, Message::Service(Service::ClockSet(c))), Box::new(|_| {}))
-                        })
-                    });
+                    let r = street.act(|s| s.set_clock(Lamps::These(&list), c));
                     message.set(Some(match r {
                         Ok(()) => format!("clock {c} sent to {} lamp(s)", list.len()),
                         Err(e) => format!("nothing sent: {e}"),

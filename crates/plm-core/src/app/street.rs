@@ -4,7 +4,8 @@
 //!
 //! - a discovery, then a background sweep of rounds of reads
 //!   ([`super::sweep::Round`]) that also probes for boards powered later;
-//! - dimming and clocks, and any request, for one lamp or all;
+//! - dimming and clocks for one lamp, a selection or all ([`Lamps`]), and
+//!   any request;
 //! - a firmware update campaign ([`Campaign`]) that has the line to
 //!   itself;
 //! - the fleet: what is known of each lamp, and alerts when one fails or
@@ -29,7 +30,7 @@ use super::hid::{self, Hid};
 use super::job::{Begun, Job, Router, Run};
 use super::message::Message;
 use super::requester::{AppEvent, Request, RequestId};
-use super::service::{Discovered, Service};
+use super::service::{Clock, Discovered, Service};
 use super::sweep::{Known, Round, RoundConfig};
 use crate::time::{Duration, Instant, MS};
 use alloc::collections::BTreeMap;
@@ -50,6 +51,15 @@ pub struct Sweep {
     pub total: usize,
     /// Completed rounds.
     pub rounds: u64,
+}
+
+/// Which lamps a command goes to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lamps<'a> {
+    /// Every lamp at once: one broadcast, which has no answer.
+    All,
+    /// These (one, or a selection): a request each, each acknowledged.
+    These(&'a [Address]),
 }
 
 /// What changed since [`Street::take`] was last called.
@@ -85,7 +95,8 @@ enum Purpose<R> {
     /// Read every parameter.
     Read(Address),
     Dim(Address, u8),
-    /// Its fate matters to nobody (dimming every lamp).
+    /// Its fate matters to nobody but the fleet (dimming every lamp,
+    /// setting clocks).
     None,
     /// Asked by the caller: its outcome goes back with `R`.
     View(R),
@@ -322,30 +333,55 @@ impl<R> Street<R> {
         self.submit(conc, now, request, Purpose::Read(address));
     }
 
-    /// Dims one lamp, or every lamp with `None` (broadcast). Refused
+    /// Dims `lamps` (each read again once it has acknowledged, to see its
+    /// power follow; all: the street is swept again in 2 s). Refused
     /// before anything is sent when the value is not 0-100.
     pub fn dim(
         &mut self,
         conc: &mut Concentrator,
         now: Instant,
-        target: Option<Address>,
+        lamps: Lamps<'_>,
         level: u8,
     ) -> Result<(), String> {
-        let m = Message::Hid(Hid::Dimming(level));
-        m.validate()?;
+        let m = || Message::Hid(Hid::Dimming(level));
+        m().validate()?;
         if self.down.is_some() {
             return Ok(());
         }
-        match target {
-            Some(a) => self.submit(conc, now, Request::to(a, m), Purpose::Dim(a, level)),
-            None => {
-                self.submit(conc, now, Request::all(m), Purpose::None);
+        match lamps {
+            Lamps::These(list) => {
+                for &a in list {
+                    self.submit(conc, now, Request::to(a, m()), Purpose::Dim(a, level));
+                }
+            }
+            Lamps::All => {
+                self.submit(conc, now, Request::all(m()), Purpose::None);
                 for lamp in self.fleet.values_mut() {
                     lamp.dimming = Some(level);
                 }
-                // Read the street again soon to see the power follow.
                 self.next_sweep = Some(now + 2_000 * MS);
             }
+        }
+        Ok(())
+    }
+
+    /// Sets the clocks of `lamps` to `clock`.
+    pub fn set_clock(
+        &mut self,
+        conc: &mut Concentrator,
+        now: Instant,
+        lamps: Lamps<'_>,
+        clock: Clock,
+    ) -> Result<(), String> {
+        let m = || Message::Service(Service::ClockSet(clock));
+        m().validate()?;
+        match lamps {
+            Lamps::These(list) => {
+                for &a in list {
+                    self.submit(conc, now, Request::to(a, m()), Purpose::None);
+                }
+            }
+            Lamps::All => self.submit(conc, now, Request::all(m()), Purpose::None),
         }
         Ok(())
     }
