@@ -252,9 +252,11 @@ impl<R> Street<R> {
         self.job.as_ref().is_some_and(Run::is_held)
     }
 
-    /// Whether a discovery, the sweep or the update has the line now.
+    /// Whether a discovery or the sweep's round has the line now (the
+    /// work its driver's page may hold for a draw; the update is not
+    /// held).
     pub fn is_busy(&self) -> bool {
-        self.job.is_some() || self.updating()
+        self.job.is_some()
     }
 
     /// Starts a discovery (a new session: every board answers again).
