@@ -350,19 +350,12 @@ impl<R> Street<R> {
         if self.down.is_some() {
             return Ok(());
         }
-        match lamps {
-            Lamps::These(list) => {
-                for &a in list {
-                    self.submit(conc, now, Request::to(a, m()), Purpose::Dim(a, level));
-                }
+        self.send_to(conc, now, lamps, m, |a| Purpose::Dim(a, level));
+        if lamps == Lamps::All {
+            for lamp in self.fleet.values_mut() {
+                lamp.dimming = Some(level);
             }
-            Lamps::All => {
-                self.submit(conc, now, Request::all(m()), Purpose::None);
-                for lamp in self.fleet.values_mut() {
-                    lamp.dimming = Some(level);
-                }
-                self.next_sweep = Some(now + 2_000 * MS);
-            }
+            self.next_sweep = Some(now + 2_000 * MS);
         }
         Ok(())
     }
@@ -377,15 +370,28 @@ impl<R> Street<R> {
     ) -> Result<(), String> {
         let m = || Message::Service(Service::ClockSet(clock));
         m().validate()?;
+        self.send_to(conc, now, lamps, m, |_| Purpose::None);
+        Ok(())
+    }
+
+    /// Sends what `m` makes to `lamps`: a request each, for `p` of its
+    /// lamp, or one broadcast.
+    fn send_to(
+        &mut self,
+        conc: &mut Concentrator,
+        now: Instant,
+        lamps: Lamps<'_>,
+        m: impl Fn() -> Message,
+        p: impl Fn(Address) -> Purpose<R>,
+    ) {
         match lamps {
             Lamps::These(list) => {
                 for &a in list {
-                    self.submit(conc, now, Request::to(a, m()), Purpose::None);
+                    self.submit(conc, now, Request::to(a, m()), p(a));
                 }
             }
             Lamps::All => self.submit(conc, now, Request::all(m()), Purpose::None),
         }
-        Ok(())
     }
 
     /// Sends any request; its outcome comes back with `reply`
