@@ -470,11 +470,27 @@ impl Session {
     }
 
     /// [`Session::next_due`] on the page's clock (µs), or when notes held
-    /// back are due.
+    /// back are due ([`Session::notes_due`]).
     pub fn next_wake(&self) -> Option<f64> {
-        let notes = (!self.out.notes.is_empty()).then_some(self.show_at());
         let due = self.next_due().and_then(|t| self.drive.pacer.page_at(t));
-        [notes, due].into_iter().flatten().reduce(f64::min)
+        [self.notes_due(), due]
+            .into_iter()
+            .flatten()
+            .reduce(f64::min)
+    }
+
+    /// When the notes held back are handed out (µs of the page's clock):
+    /// while a request is on the line they wait for its answer, which
+    /// wakes the page ([`Session::take_due`]), or for a busy line's
+    /// hand-out at the latest; the page is not woken for them at once,
+    /// tick after tick, until then.
+    fn notes_due(&self) -> Option<f64> {
+        let busy = if self.active.is_some() {
+            BUSY_SHOW_EVERY
+        } else {
+            0.0
+        };
+        (!self.out.notes.is_empty()).then_some(self.show_at() + busy)
     }
 
     /// Hands the next queued request to the engine when none is
@@ -872,6 +888,15 @@ mod tests {
                 replied.push(*page);
             }
             assert!(s.active.is_none() || !s.drawing());
+            // Notes held for the answer on the line do not wake the page
+            // at once, tick after tick, until it comes.
+            if s.active.is_some() {
+                let due = s.notes_due().unwrap_or(f64::INFINITY);
+                assert!(
+                    due > *page,
+                    "notes due at once ({due}) mid-request at {page}"
+                );
+            }
             (!t.notes.is_empty()).then_some((*page, t.notes.len()))
         };
         let seen = Seen::default();

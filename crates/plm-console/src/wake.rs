@@ -17,12 +17,23 @@
 //! must act at once ([`exactly`]: the last byte on the UART either way
 //! arrives, where a frame may end, to be ACKed or answered) is waited,
 //! when closer than 2 ms, by the timer's whole milliseconds rounded down
-//! and its last fraction of one by messages, one after the page's other
-//! tasks. Every other deadline (the world's next byte, the engine's
-//! timeouts, the idle wake) is waited by the timer rounded up: spinning on
-//! messages for every byte of a frame left so much garbage (45 MB in 300
-//! reads) that the page collected it every few hundred ms, 3-8 ms each, in
-//! the middle of a modem's frame.
+//! and its last fraction of one spun in the task that finds it, the clock
+//! read about every 25 µs. Every other deadline (the world's next byte,
+//! the engine's timeouts, the idle wake) is waited by the timer rounded
+//! up. Garbage is what makes ACKs late: the page collects it, 3-8 ms at a
+//! time, in the middle of a modem's frame. Spinning on messages for every
+//! byte of a frame left 45 MB in 300 reads; for the last fraction before a
+//! frame's end, 1.7 MB (a `MessageEvent` each, and a number from the clock
+//! at each look); spun in the task, next to none.
+//!
+//! A deadline is run once the page's clock has reached it, not before
+//! (the clock is coarse, 100 µs, in a page that is not cross-origin
+//! isolated): run early, the sessions found nothing to do and asked again
+//! at once, through a message after message. What the page's work asks
+//! for while it runs is armed once it returns: a later deadline by a
+//! timer set from that task (nested timers are clamped, so every few
+//! through a message), one due at once through a message, after the
+//! page's other tasks.
 //!
 //! A draw handed out holds the line until the page has painted it
 //! ([`Draw`]): the page's next frame, counted by the message it posts
@@ -45,7 +56,7 @@ mod page {
         #[wasm_bindgen(js_name = postMessage)]
         fn post_message(message: &JsValue, origin: &JsValue);
         #[wasm_bindgen(js_name = setTimeout)]
-        fn set_timeout(run: &JsValue, ms: u32);
+        fn set_timeout(run: &JsValue, ms: u32, nesting: u32);
         #[wasm_bindgen(js_name = requestAnimationFrame)]
         fn request_animation_frame(run: &JsValue);
     }
@@ -55,8 +66,11 @@ mod page {
         run: Box<dyn Fn()>,
         /// `postMessage`'s origin ("*").
         origin: JsValue,
-        /// Runs at each message and timer: looks whether something is due.
-        on_wake: Closure<dyn FnMut()>,
+        /// Runs at each message: looks whether something is due (kept
+        /// alive here: the page's message listener).
+        _on_wake: Closure<dyn FnMut()>,
+        /// Runs at each timer, given its nesting level.
+        on_timer: Closure<dyn FnMut(u32)>,
         on_frame: Closure<dyn FnMut()>,
     }
 
@@ -67,6 +81,10 @@ mod page {
     /// An exact deadline closer than this (ms) is met to the page's
     /// clock's resolution; a further one is first waited by the timer.
     const PRECISE_MS: f64 = 2.0;
+
+    /// While a wait spins, the clock is read about every this many µs
+    /// (each read leaves the collector a number).
+    const SPIN_READ_US: f64 = 25.0;
 
     thread_local! {
         static PAGE: OnceCell<Page> = const { OnceCell::new() };
@@ -87,17 +105,42 @@ mod page {
         static FRAME_ASKED: Cell<f64> = const { Cell::new(f64::INFINITY) };
         /// A frame is being painted: the next message comes after it.
         static PAINTING: Cell<bool> = const { Cell::new(false) };
+        /// Turns of [`spin`] between two reads of the clock, measured at
+        /// [`install`].
+        static SPIN: Cell<u32> = const { Cell::new(1_000) };
+        /// The timer nesting level of the task running now (HTML, "timer
+        /// initialisation steps": 0 outside a timer's task).
+        static NEST: Cell<u32> = const { Cell::new(0) };
+        /// The page's work is running: what it asks for is armed after.
+        static RUNNING: Cell<bool> = const { Cell::new(false) };
+    }
+
+    /// Timers nested this deep are clamped to 4 ms (HTML, "timer
+    /// initialisation steps": nesting level above 5; Chromium from 5): the
+    /// next is set from a message's task instead.
+    const NEST_MAX: u32 = 4;
+
+    /// About [`SPIN_READ_US`] of work that reads nothing.
+    fn spin() {
+        for i in 0..SPIN.get() {
+            std::hint::black_box(i);
+        }
     }
 
     pub fn install(run: Box<dyn Fn()>) {
         let on_wake = Closure::<dyn FnMut()>::new(|| {
             POSTED.set(false);
+            NEST.set(0);
             // Tasks queued during a frame run once it is painted; then the
             // page runs, for what waited for the paint.
             if PAINTING.replace(false) {
                 FRAMES.set(FRAMES.get() + 1);
                 DUE.set(0.0);
             }
+            arm();
+        });
+        let on_timer = Closure::<dyn FnMut(u32)>::new(|nesting| {
+            NEST.set(nesting);
             arm();
         });
         let on_frame = Closure::<dyn FnMut()>::new(|| {
@@ -115,10 +158,19 @@ mod page {
             let _ = p.set(Page {
                 run,
                 origin: JsValue::from_str("*"),
-                on_wake,
+                _on_wake: on_wake,
+                on_timer,
                 on_frame,
             });
         });
+        // How many turns of the spin take SPIN_READ_US (the clock may
+        // be coarse, 100 µs: a few ms are measured, once).
+        let (turns, start) = (SPIN.get(), page_now_us());
+        for _ in 0..1_000 {
+            spin();
+        }
+        let took = (page_now_us() - start).max(100.0);
+        SPIN.set((f64::from(turns) * 1_000.0 * SPIN_READ_US / took).max(1.0) as u32);
         // What was asked for before.
         post();
     }
@@ -154,17 +206,39 @@ mod page {
     }
 
     /// Runs if due, else waits for the time left: the whole milliseconds
-    /// by a timer, the rest by messages.
+    /// by a timer, the rest of an exact wait spun here. What the page's
+    /// work asks for is armed once it has run: at once, through a message
+    /// (the page's other tasks go first); later, by a timer set here
+    /// (nested timers are clamped: every few, through a message).
     fn arm() {
-        let now = page_now_us();
+        let due = DUE.get();
+        let mut now = page_now_us();
+        if EXACT.get() && due - now < 1_000.0 {
+            while now < due {
+                spin();
+                now = page_now_us();
+            }
+        }
         if TIMER_AT.get() <= now + 100.0 {
             TIMER_AT.set(f64::INFINITY);
         }
-        let due = DUE.get();
-        if due <= now + 100.0 {
+        // Due when the page's clock has reached it, not before: the
+        // sessions run their time up to that clock (coarse in a page that
+        // is not cross-origin isolated, 100 µs), and run early they would
+        // find nothing to do and ask again at once.
+        if due <= now {
             DUE.set(f64::INFINITY);
+            RUNNING.set(true);
             PAGE.with(|p| p.get().map(|p| (p.run)()));
+            RUNNING.set(false);
+            now = page_now_us();
+        }
+        let due = DUE.get();
+        if due == f64::INFINITY {
             return;
+        }
+        if due <= now || NEST.get() >= NEST_MAX {
+            return post();
         }
         let left = (due - now) / 1_000.0;
         let ms = if EXACT.get() && left < PRECISE_MS {
@@ -172,11 +246,13 @@ mod page {
         } else {
             left.ceil()
         };
-        if ms < 1.0 {
-            post();
-        } else if now + ms * 1_000.0 < TIMER_AT.get() {
+        if now + ms * 1_000.0 < TIMER_AT.get() {
             TIMER_AT.set(now + ms * 1_000.0);
-            PAGE.with(|p| p.get().map(|p| set_timeout(p.on_wake.as_ref(), ms as u32)));
+            let nesting = NEST.get() + 1;
+            PAGE.with(|p| {
+                p.get()
+                    .map(|p| set_timeout(p.on_timer.as_ref(), ms as u32, nesting))
+            });
         }
     }
 
@@ -185,7 +261,10 @@ mod page {
         if page_us < due || (exact && page_us == due) {
             DUE.set(page_us);
             EXACT.set(exact);
-            post();
+            // Armed once the page's work has run, if it is running.
+            if !RUNNING.get() {
+                post();
+            }
         }
     }
 
@@ -276,6 +355,27 @@ pub fn at(page_us: f64) {
     let _ = page_us;
 }
 
+/// Runs the page's work when it is next due: at `due` (µs of the page's
+/// clock, within a millisecond), or at `exact` to the clock's resolution
+/// ([`exactly`]). A deadline met within a millisecond (a byte in a
+/// modem's frame, an engine's timeout) waits for the exact one when that
+/// comes within the millisecond: met exactly, it covers both, with one
+/// wake rather than two.
+pub fn next(due: f64, exact: Option<f64>) {
+    match plan(due, exact) {
+        (t, true) => exactly(t),
+        (t, false) => at(t),
+    }
+}
+
+/// When [`next`] wakes the page, and whether exactly.
+fn plan(due: f64, exact: Option<f64>) -> (f64, bool) {
+    match exact {
+        Some(e) if e < due + 1_000.0 => (e, true),
+        _ => (due, false),
+    }
+}
+
 /// Runs the page's work when the page's clock reaches `page_us` (µs), to
 /// the clock's resolution: a modem's frame may end then, to be ACKed at
 /// once ([`crate::transport::Transport::uart_due`]).
@@ -284,4 +384,20 @@ pub fn exactly(page_us: f64) {
     page::at(page_us, true);
     #[cfg(not(target_arch = "wasm32"))]
     let _ = page_us;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The end of a run of bytes within a millisecond of the next
+    /// deadline is the one wake, met exactly; a later one waits for its
+    /// turn.
+    #[test]
+    fn one_wake_covers_a_deadline_and_the_exact_one_right_after() {
+        assert_eq!(plan(10_000.0, None), (10_000.0, false));
+        assert_eq!(plan(10_000.0, Some(10_600.0)), (10_600.0, true));
+        assert_eq!(plan(10_000.0, Some(9_000.0)), (9_000.0, true));
+        assert_eq!(plan(10_000.0, Some(11_000.0)), (10_000.0, false));
+    }
 }

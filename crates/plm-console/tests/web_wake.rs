@@ -1,15 +1,18 @@
 //! The page's wake in headless Chromium, installed as the console
 //! installs it (`app.rs`): a draw holds the line until the page has
 //! painted a frame, then the page runs and the line goes on
-//! (`wake::Draw`). A suite of its own: the other suites drive their
-//! sessions with their own timers, and a session's draws wait for frames
-//! only under the wake.
+//! (`wake::Draw`); a deadline the page's clock has not reached is waited
+//! for, not run early and asked again through a message after message.
+//! A suite of its own: the other suites drive their sessions with their
+//! own timers, and a session's draws wait for frames only under the
+//! wake.
 #![cfg(target_arch = "wasm32")]
 
 use js_sys::Promise;
+use plm_console::clock::page_now_us;
 use plm_console::wake::{self, Draw};
 use std::cell::Cell;
-use std::rc::Rc;
+use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::JsFuture;
 use wasm_bindgen_test::*;
 
@@ -35,14 +38,38 @@ async fn sleep(ms: i32) {
     JsFuture::from(promise).await.expect("a timer");
 }
 
+thread_local! {
+    /// Times the page's work ran.
+    static RUNS: Cell<u32> = const { Cell::new(0) };
+    /// µs ahead the page's work asks to run again (0: it does not).
+    static AGAIN_US: Cell<f64> = const { Cell::new(0.0) };
+    static INSTALLED: Cell<bool> = const { Cell::new(false) };
+}
+
+fn runs() -> u32 {
+    RUNS.with(Cell::get)
+}
+
+/// The wake installed once for the suite (as the console does, once a
+/// page), its work counted.
+fn install() {
+    if !INSTALLED.with(|i| i.replace(true)) {
+        wake::install(|| {
+            RUNS.with(|r| r.set(r.get() + 1));
+            let ahead = AGAIN_US.with(Cell::get);
+            if ahead > 0.0 {
+                wake::at(page_now_us() + ahead);
+            }
+        });
+    }
+}
+
 #[wasm_bindgen_test]
 async fn a_draw_holds_the_line_until_the_page_has_painted_a_frame() {
-    let runs = Rc::new(Cell::new(0u32));
-    let counted = runs.clone();
-    wake::install(move || counted.set(counted.get() + 1));
+    install();
     next_frame().await;
     sleep(5).await;
-    let (before, ran) = (wake::frames(), runs.get());
+    let (before, ran) = (wake::frames(), runs());
     let mut draw = Draw::default();
     draw.begin();
     draw.settle();
@@ -60,7 +87,38 @@ async fn a_draw_holds_the_line_until_the_page_has_painted_a_frame() {
     assert!(wake::frames() > before, "the frame after the draw counted");
     // The page ran once it was painted, for what waited for the paint:
     // nothing else asked for it here.
-    assert!(runs.get() > ran, "the page ran after the paint");
+    assert!(runs() > ran, "the page ran after the paint");
     draw.settle();
     assert!(!draw.pending(), "painted: the line goes on");
+}
+
+/// Work that asks to run again 50 µs on, less than the page's clock's step
+/// in a page that is not cross-origin isolated (100 µs), runs when the
+/// clock has reached it: about once a millisecond by the timer, not at
+/// once through a message, run after run, each finding it not due yet.
+#[wasm_bindgen_test]
+async fn a_deadline_the_clock_has_not_reached_is_waited_for_not_spun_on() {
+    install();
+    next_frame().await;
+    let messages = std::rc::Rc::new(Cell::new(0u32));
+    let counted = messages.clone();
+    let listener = Closure::<dyn FnMut()>::new(move || counted.set(counted.get() + 1));
+    let window = web_sys::window().expect("a window");
+    window
+        .add_event_listener_with_callback("message", listener.as_ref().unchecked_ref())
+        .expect("a listener");
+    let ran = runs();
+    AGAIN_US.with(|a| a.set(50.0));
+    wake::soon();
+    sleep(30).await;
+    AGAIN_US.with(|a| a.set(0.0));
+    let (runs, messages) = (runs() - ran, messages.get());
+    window
+        .remove_event_listener_with_callback("message", listener.as_ref().unchecked_ref())
+        .expect("no listener");
+    assert!(runs >= 10, "the work goes on: {runs} runs in 30 ms");
+    assert!(
+        messages <= runs / 2 + 2,
+        "{messages} messages for {runs} runs: the wake spun on messages"
+    );
 }

@@ -67,10 +67,7 @@ impl Console {
         .into_iter()
         .flatten()
         .fold(now + IDLE_WAKE_US, f64::min);
-        crate::wake::at(due);
-        if let Some(exact) = self.with_driver(Driver::exact_wake) {
-            crate::wake::exactly(exact);
-        }
+        crate::wake::next(due, self.with_driver(Driver::exact_wake));
     }
 
     /// Applies what happened without letting time pass, and has the
