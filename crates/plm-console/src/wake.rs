@@ -141,6 +141,10 @@ mod page {
         });
         let on_timer = Closure::<dyn FnMut(u32)>::new(|nesting| {
             NEST.set(nesting);
+            // The timer waited for has fired, whatever the page's coarse
+            // clock reads: left set, the next would never be (an earlier
+            // one still pending at worst runs the page once for nothing).
+            TIMER_AT.set(f64::INFINITY);
             arm();
         });
         let on_frame = Closure::<dyn FnMut()>::new(|| {
