@@ -60,6 +60,17 @@ pub struct StreetTick {
     pub show: bool,
 }
 
+/// What the session itself adds to a tick, beside the street's
+/// [`plm_core::app::street::Changes`].
+#[derive(Default)]
+struct Pending {
+    traffic: Vec<(Instant, Decoded)>,
+    sent: u64,
+    /// Kept until the views are drawn ([`StreetSession::hand_out`]).
+    found: bool,
+    show: bool,
+}
+
 /// The street session.
 pub struct StreetSession {
     /// The transport, the page's clock on it, the ACK latency, the work.
@@ -69,7 +80,7 @@ pub struct StreetSession {
     street: Street<StreetReply>,
     /// Names the modem's host-interface traffic (bare modem profile).
     decoder: Decoder,
-    out: StreetTick,
+    out: Pending,
     /// When the street's views were last drawn, and whether a change
     /// waits.
     shown: Throttle,
@@ -91,7 +102,7 @@ impl StreetSession {
             street: Street::new(&conc),
             conc,
             decoder: Decoder::new(Dialect::St7580, Source::Any),
-            out: StreetTick::default(),
+            out: Pending::default(),
             shown: Throttle::new(STREET_DRAW_US),
             hold: Default::default(),
         }
@@ -202,37 +213,38 @@ impl StreetSession {
         self.street.set_sweep(now, on);
     }
 
+    /// Has the street send something now (`f`), and what it sent written
+    /// at once.
+    fn send<T>(
+        &mut self,
+        f: impl FnOnce(&mut Street<StreetReply>, &mut Concentrator, Instant) -> T,
+    ) -> T {
+        let now = self.now();
+        let out = f(&mut self.street, &mut self.conc, now);
+        driver::flush(self, now);
+        out
+    }
+
     /// Reads every parameter of one lamp now.
     pub fn read(&mut self, address: Address) {
-        let now = self.now();
-        self.street.read(&mut self.conc, now, address);
-        driver::flush(self, now);
+        self.send(|s, conc, now| s.read(conc, now, address))
     }
 
     /// Dims `lamps` ([`Street::dim`]). Refused before anything is sent
     /// when the value is not 0-100.
     pub fn dim(&mut self, lamps: Lamps<'_>, level: u8) -> Result<(), String> {
-        let now = self.now();
-        self.street.dim(&mut self.conc, now, lamps, level)?;
-        driver::flush(self, now);
-        Ok(())
+        self.send(|s, conc, now| s.dim(conc, now, lamps, level))
     }
 
     /// Sets the clocks of `lamps` to `clock`.
     pub fn set_clock(&mut self, lamps: Lamps<'_>, clock: Clock) -> Result<(), String> {
-        let now = self.now();
-        self.street.set_clock(&mut self.conc, now, lamps, clock)?;
-        driver::flush(self, now);
-        Ok(())
+        self.send(|s, conc, now| s.set_clock(conc, now, lamps, clock))
     }
 
     /// Sends any request from a view; `reply` gets the answer. Refused
     /// before anything is sent when the board would refuse it.
     pub fn request(&mut self, request: Request, reply: StreetReply) -> Result<(), String> {
-        let now = self.now();
-        self.street.request(&mut self.conc, now, request, reply)?;
-        driver::flush(self, now);
-        Ok(())
+        self.send(|s, conc, now| s.request(conc, now, request, reply))
     }
 
     /// Whether the street's next requests wait for the page: through a
@@ -281,7 +293,9 @@ impl StreetSession {
             replies: c.replies,
             campaign: c.campaign,
             found: c.found || out.found,
-            ..out
+            traffic: out.traffic,
+            sent: out.sent,
+            show: out.show,
         }
     }
 

@@ -14,7 +14,7 @@
 //!
 //! A timer waits whole milliseconds, and rounded up that made an ACK up to
 //! 1 ms late (issue 13: p50 0.5 ms). So the deadline at which the host
-//! must act at once ([`exactly`]: the last byte on the UART either way
+//! must act at once ([`next`]: the last byte on the UART either way
 //! arrives, where a frame may end, to be ACKed or answered) is waited,
 //! when closer than 2 ms, by the timer's whole milliseconds rounded down
 //! and its last fraction of one spun in the task that finds it, the clock
@@ -361,7 +361,7 @@ pub fn at(page_us: f64) {
 
 /// Runs the page's work when it is next due: at `due` (µs of the page's
 /// clock, within a millisecond), or at `exact` to the clock's resolution
-/// ([`exactly`]). A deadline met within a millisecond (a byte in a
+/// (`exactly`). A deadline met within a millisecond (a byte in a
 /// modem's frame, an engine's timeout) waits for the exact one when that
 /// comes within the millisecond: met exactly, it covers both, with one
 /// wake rather than two.
@@ -383,7 +383,7 @@ fn plan(due: f64, exact: Option<f64>) -> (f64, bool) {
 /// Runs the page's work when the page's clock reaches `page_us` (µs), to
 /// the clock's resolution: a modem's frame may end then, to be ACKed at
 /// once ([`crate::transport::Transport::uart_due`]).
-pub fn exactly(page_us: f64) {
+fn exactly(page_us: f64) {
     #[cfg(target_arch = "wasm32")]
     page::at(page_us, true);
     #[cfg(not(target_arch = "wasm32"))]
