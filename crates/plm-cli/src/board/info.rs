@@ -69,8 +69,7 @@ pub fn status_all(d: &mut Driver, config: DiscoveryConfig, json: bool) -> Result
     let started = std::time::Instant::now();
     tell!("plm board: discovering, then reading every lamp found");
     let mut street = Street::<()>::new(d.concentrator());
-    street.set_session(config.session.wrapping_sub(1));
-    street.discover_expecting(d.now(), config.guess);
+    street.discover_with(d.now(), config);
     let mut told = false;
     d.run(&mut street, |s, _, _| {
         if !told && s.discovering().is_none() {

@@ -261,14 +261,17 @@ impl<R> Street<R> {
 
     /// Starts a discovery (a new session: every board answers again).
     pub fn discover(&mut self, now: Instant) {
-        self.discover_expecting(now, self.fleet.len().max(12));
+        let session = self.session_no.wrapping_add(1);
+        let guess = self.fleet.len().max(12);
+        self.discover_with(now, DiscoveryConfig::new(session, guess));
     }
 
-    /// [`Street::discover`], with about `guess` boards expected.
-    pub fn discover_expecting(&mut self, now: Instant, guess: usize) {
-        self.session_no = self.session_no.wrapping_add(1);
+    /// Starts a discovery as `config` says (its session the street's from
+    /// now on).
+    pub fn discover_with(&mut self, now: Instant, config: DiscoveryConfig) {
+        self.session_no = config.session;
         self.look_for_new = false;
-        let (d, first) = Discovery::start(now, DiscoveryConfig::new(self.session_no, guess));
+        let (d, first) = Discovery::start(now, config);
         self.job = Some(Run::new(StreetJob::Discovery(Begun::new(d, Some(first)))));
         self.found_before_frame = 0;
         self.out.found = true;
