@@ -64,9 +64,10 @@ pub struct StreetTick {
 /// [`plm_core::app::street::Changes`].
 #[derive(Default)]
 struct Pending {
+    /// Kept, with `sent` and `found`, until the views are drawn
+    /// ([`StreetSession::hand_out`]): the Traffic table's rows too.
     traffic: Vec<(Instant, Decoded)>,
     sent: u64,
-    /// Kept until the views are drawn ([`StreetSession::hand_out`]).
     found: bool,
     show: bool,
 }
@@ -279,7 +280,8 @@ impl StreetSession {
     /// (T_ACK, UM0932 3.2.8). Through a board, the board ACKs its modem:
     /// nothing waits.
     fn draw_first(&self) -> bool {
-        let changed = self.street.changes().changed || self.out.sent > 0;
+        let changed =
+            self.street.changes().changed || self.out.sent > 0 || !self.out.traffic.is_empty();
         self.street.via_modem() && self.shown.due(changed, self.drive.tick_at())
     }
 
@@ -312,13 +314,16 @@ impl StreetSession {
             STREET_DRAW_US
         };
         let mut tick = self.take();
-        let changed = tick.changed || tick.sent > 0;
+        let changed = tick.changed || tick.sent > 0 || !tick.traffic.is_empty();
         tick.show |= self.shown.show_after(changed, page_us, after);
         // Counted on until the views show it; the street found is kept
-        // then too (the browser's storage written at a quiet moment).
+        // then too (the browser's storage written at a quiet moment), and
+        // the Traffic table's rows (a redraw of it while a modem's frame
+        // may end holds up its ACK).
         if !tick.show {
             self.out.sent = tick.sent;
             self.out.found = tick.found;
+            self.out.traffic = std::mem::take(&mut tick.traffic);
         }
         tick
     }

@@ -211,17 +211,23 @@ fn a_stamped_byte_keeps_its_time_and_value() {
     }
 }
 
-/// A page whose every redraw of the street takes `draw_us` of its clock
-/// (its layout and paint, [`crate::wake::Draw`]), through discovery and two
-/// sweeps over a bare ST7580: the ACKs of the console's host engine, on
-/// the page's clock, and the longest the views went undrawn during
-/// discovery (µs).
-fn acks_with_redraws(draw_us: f64) -> (AckLatency, f64) {
+/// A page whose every redraw of the street or of its Traffic table takes
+/// `draw_us` of its clock (its layout and paint, [`crate::wake::Draw`]),
+/// through discovery and two sweeps over a bare ST7580: the ACKs of the
+/// console's host engine, on the page's clock, the longest the views
+/// went undrawn during discovery (µs), and how many times the Traffic
+/// table got rows without the street's draw (at a moment not quiet).
+fn acks_with_redraws(draw_us: f64) -> (AckLatency, f64, usize) {
     let (_owner, c) = console(Profile::StreetModem, 1);
-    let mut version = c.street.version.get_untracked();
-    let (mut drawn, mut longest) = (0.0, 0.0f64);
+    let versions = |c: &Console| {
+        let rows = c.traffic.log.with_untracked(|l| l.next_seq());
+        (c.street.version.get_untracked(), rows)
+    };
+    let mut version = versions(&c);
+    let (mut drawn, mut longest, mut rows_alone) = (0.0, 0.0f64, 0);
     run_until(&c, 30.0, |c| {
-        let v = c.street.version.get_untracked();
+        let v = versions(c);
+        rows_alone += (v.0 == version.0 && v.1 != version.1) as usize;
         if v != version {
             version = v;
             let now = crate::clock::page_now_us();
@@ -233,13 +239,14 @@ fn acks_with_redraws(draw_us: f64) -> (AckLatency, f64) {
         }
         c.street.read(|s| s.sweep().rounds > 1)
     });
-    (c.ack_latency(), longest)
+    (c.ack_latency(), longest, rows_alone)
 }
 
 #[test]
 fn the_streets_redraws_come_while_the_line_is_quiet_and_hold_up_no_ack() {
-    let (acks, longest) = acks_with_redraws(10_000.0);
+    let (acks, longest, rows_alone) = acks_with_redraws(10_000.0);
     assert!(acks.count >= 40, "{acks:?}");
+    assert_eq!(rows_alone, 0, "Traffic rows handed out between draws");
     assert!(acks.page.p99 < 2_000, "{acks:?}");
     // The views still follow the street.
     assert!(
