@@ -67,8 +67,8 @@ fn run(boards: usize, guess: usize, line: Line, seed: u64) -> (usize, u8, f64) {
             if rng.chance(line.loss) {
                 continue;
             }
-            if let Some(after) = r.on_request(me, service) {
-                slots[(after / slot_us) as usize].push(i);
+            if let Some(slot) = r.on_request(me, service) {
+                slots[(slot.start / slot_us) as usize].push(i);
             }
         }
         for slot in &slots {

@@ -1126,3 +1126,37 @@ fn host_gives_up_on_a_modem_busy_for_good() {
     assert_eq!(sim.host.pending(), 0);
     assert!(sim.requests().is_empty());
 }
+
+#[test]
+fn a_frame_the_modem_has_not_let_out_yet_can_be_withdrawn() {
+    let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
+    // Bit 2: a power line frame is being received.
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x04]));
+    let waiting = sim.submit(ping());
+    let queued = sim.submit(ping());
+    sim.run_until(20 * MS);
+    assert!(sim.host.withdraw(sim.now, queued), "queued behind it");
+    assert!(sim.host.withdraw(sim.now, waiting), "met only \"not now\"");
+    assert!(!sim.host.withdraw(sim.now, waiting), "gone already");
+    assert_eq!(sim.host.pending(), 0);
+    sim.dev
+        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0]));
+    sim.run_until(200 * MS);
+    // Nothing sent, no event: the caller gave it up.
+    assert!(sim.wire(Dir::HostToDev).next().is_none());
+    assert!(sim
+        .host_events_where(|e| is_retry(e) || is_failed(e) || is_delivered(e))
+        .is_empty());
+    // A frame that has left is not withdrawn: its fate comes as an event.
+    let sent = sim.submit(ping());
+    sim.run_to_idle();
+    assert!(!sim.host.withdraw(sim.now, sent));
+    assert_eq!(
+        sim.host_events_where(is_delivered)
+            .into_iter()
+            .map(|(_, e)| e)
+            .collect::<Vec<_>>(),
+        vec![Event::Delivered(sent)]
+    );
+}

@@ -26,7 +26,7 @@ use plm_core::app::service::{Discovered, Release, Service, SlotRead, PARAM_LEN, 
 use plm_core::app::{
     Address, AppFrame, Clock, ErrorCode, FrameType, LineFrame, Message, UsartDecoder, UsartElement,
 };
-use plm_core::link::host::{Event, HostConfig, HostEngine, Transmit};
+use plm_core::link::host::{Event, HostConfig, HostEngine, Ticket, Transmit};
 use plm_core::link::Dialect;
 use plm_core::st7580::{Command, DataRequest, TxParams};
 use plm_core::time::{earliest, Instant};
@@ -74,13 +74,24 @@ pub struct BoardConfig {
     pub modulation: plm_core::st7580::Modulation,
 }
 
-/// A line frame the firmware made: when, and when it goes to the modem
-/// (drawn with [`FIRMWARE_JITTER`] before the board's turn ends).
+/// A line frame the firmware made: when, when it goes to the modem
+/// (drawn with [`FIRMWARE_JITTER`] before the board's turn ends), and
+/// when it is given up if it has not left by then (a discovery reply at
+/// its slot's end, [`Responder::on_request`]).
 #[derive(Debug, Clone)]
 struct LineOut {
     made: Instant,
     due: Option<Instant>,
+    until: Option<Instant>,
     frame: LineFrame,
+}
+
+/// A discovery reply to send: when, given up when, to whom.
+#[derive(Debug, Clone, Copy)]
+struct DiscoveryReply {
+    at: Instant,
+    until: Option<Instant>,
+    to: Address,
 }
 
 /// A pending MIB frame: who asked, and whether it was a write.
@@ -109,7 +120,10 @@ pub struct Board {
     /// board was acknowledged in, and when its reply is due (to whom).
     discovery_session: Option<u8>,
     discovery_acked: Option<u8>,
-    discovery_reply: Option<(Instant, Address)>,
+    discovery_reply: Option<DiscoveryReply>,
+    /// The modem's frame withdrawn at this instant if none of it has
+    /// left ([`LineOut::until`]).
+    withdraw: Option<(Ticket, Instant)>,
     /// Discovery rule 2: quiet once named in a session.
     responder: Responder,
     /// Broadcasts it could not read: left unanswered (hundreds of error
@@ -159,6 +173,7 @@ impl Board {
             discovery_session: None,
             discovery_acked: None,
             discovery_reply: None,
+            withdraw: None,
             responder: Responder::default(),
             unread_broadcasts: 0,
             mib_asks: VecDeque::new(),
@@ -199,6 +214,7 @@ impl Board {
         self.discovery_session = None;
         self.discovery_acked = None;
         self.discovery_reply = None;
+        self.withdraw = None;
         self.responder = Responder::default();
         self.mib_asks.clear();
         self.hid_answers.clear();
@@ -274,8 +290,9 @@ impl Board {
     pub fn poll_timeout(&self) -> Option<Instant> {
         let t = earliest(
             self.engine.poll_timeout(),
-            self.discovery_reply.map(|r| r.0),
+            self.discovery_reply.map(|r| r.at),
         );
+        let t = earliest(t, self.withdraw.map(|w| w.1));
         let t = earliest(t, self.hid_answers.front().map(|a| a.0));
         let t = earliest(t, self.rfu.poll_timeout());
         let t = earliest(t, self.line_out.front().and_then(|o| o.due));
@@ -301,16 +318,19 @@ impl Board {
             let (_, to, m) = self.hid_answers.pop_front().expect("front exists");
             self.answer(now, to, m);
         }
-        if let Some((at, to)) = self.discovery_reply {
-            if at <= now {
-                self.discovery_reply = None;
-                let reply = Service::DiscoverReply(Discovered {
-                    firmware: self.rfu.version(),
-                    stack: STACK,
-                    snr: self.last_snr,
-                });
-                self.send_line(now, to, &Message::Service(reply));
-            }
+        if let Some(r) = self.discovery_reply.filter(|r| r.at <= now) {
+            self.discovery_reply = None;
+            let reply = Service::DiscoverReply(Discovered {
+                firmware: self.rfu.version(),
+                stack: STACK,
+                snr: self.last_snr,
+            });
+            let line = LineFrame::from_app(&Message::Service(reply).to(r.to), self.address);
+            self.submit_line(now, &line, r.until);
+        }
+        if let Some((ticket, _)) = self.withdraw.filter(|w| w.1 <= now) {
+            self.withdraw = None;
+            self.engine.withdraw(now, ticket);
         }
         self.pump(now, rng);
     }
@@ -381,11 +401,17 @@ impl Board {
             .is_some_and(|o| o.due.is_some_and(|d| d <= now))
         {
             let o = self.line_out.pop_front().expect("front exists");
+            if o.until.is_some_and(|u| u <= now) {
+                continue;
+            }
             let cmd = Command::DlDataRequest(DataRequest {
                 params: self.params,
                 payload: o.frame.emit(),
             });
-            self.engine.submit(now, cmd.to_frame());
+            let ticket = self.engine.submit(now, cmd.to_frame());
+            if let Some(u) = o.until {
+                self.withdraw = Some((ticket, u));
+            }
         }
     }
 
@@ -399,7 +425,7 @@ impl Board {
             return;
         }
         let line = LineFrame::from_app(&frame, self.address);
-        self.submit_line(now, &line);
+        self.submit_line(now, &line, None);
     }
 
     /// A line frame for this board.
@@ -579,8 +605,12 @@ impl Board {
             }
             Service::IoConfigGet => reply(Service::IoConfig(self.io_config)),
             Service::DiscoverAny | Service::DiscoverFrame(_) => {
-                if let Some(after) = self.responder.on_request(&self.address, s) {
-                    self.discovery_reply = Some((now + after, from));
+                if let Some(slot) = self.responder.on_request(&self.address, s) {
+                    self.discovery_reply = Some(DiscoveryReply {
+                        at: now + slot.start,
+                        until: Some(now + slot.end),
+                        to: from,
+                    });
                 }
                 None
             }
@@ -588,7 +618,11 @@ impl Board {
                 self.discovery_session = Some(*session);
                 if self.discovery_acked != Some(*session) {
                     let delay = rng.below(*window as u64 * 1_000_000);
-                    self.discovery_reply = Some((now + delay, from));
+                    self.discovery_reply = Some(DiscoveryReply {
+                        at: now + delay,
+                        until: None,
+                        to: from,
+                    });
                 }
                 None
             }
@@ -699,15 +733,16 @@ impl Board {
 
     fn send_line(&mut self, now: Instant, to: Address, m: &Message) {
         let line = LineFrame::from_app(&m.to(to), self.address);
-        self.submit_line(now, &line);
+        self.submit_line(now, &line, None);
     }
 
     /// A line frame made now: it goes to the modem when
-    /// [`Board::release_line`] says.
-    fn submit_line(&mut self, now: Instant, line: &LineFrame) {
+    /// [`Board::release_line`] says, unless `until` has passed.
+    fn submit_line(&mut self, now: Instant, line: &LineFrame, until: Option<Instant>) {
         self.line_out.push_back(LineOut {
             made: now,
             due: None,
+            until,
             frame: line.clone(),
         });
     }

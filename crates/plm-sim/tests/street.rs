@@ -122,6 +122,24 @@ fn a_street_of_50_through_a_bare_modem() {
     journey(Attach::Modem);
 }
 
+/// A street 25 times the console's first guess (12): every lamp is found.
+/// Each board waits for a quiet line to send its reply (its modem's "not
+/// now"); a crowd's replies used to spill past their frame onto the next
+/// request, which no board then heard, and the silence ended the
+/// discovery with 1 lamp of 300 found (seed 7). A reply not gone by its
+/// slot's end is given up now ([`Responder::on_request`]).
+///
+/// [`Responder::on_request`]: plm_core::app::discovery::Responder::on_request
+#[test]
+fn a_street_far_larger_than_guessed_is_found_whole() {
+    for (via, seed) in [(Attach::Board, 7), (Attach::Modem, 7580)] {
+        let lamps = 300;
+        let mut d = street(lamps, via, seed);
+        let found = d.discover(plm_core::app::discovery::DiscoveryConfig::new(1, 12));
+        assert_eq!(found.len(), lamps, "{via:?}, seed {seed}");
+    }
+}
+
 /// UART faults on the concentrator's cable and losses on the line: no
 /// dimming the concentrator saw acknowledged is missing on its lamp.
 #[test]

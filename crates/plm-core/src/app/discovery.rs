@@ -32,6 +32,7 @@ use super::requester::Request;
 use super::service::{names, Discovered, Service, SlotFrame};
 use crate::time::{Duration, Instant, MS};
 use alloc::vec::Vec;
+use core::ops::Range;
 
 /// Most slots in one frame: what it hears fits the next request most of
 /// the time (at the best share a frame of 32 hears about 12; a request
@@ -302,9 +303,12 @@ pub struct Responder {
 }
 
 impl Responder {
-    /// A discovery request heard (rule 2, or bare): how long after
-    /// hearing it the board answers, or `None` for silence.
-    pub fn on_request(&mut self, me: &Address, service: &Service) -> Option<Duration> {
+    /// A discovery request heard (rule 2, or bare): its slot, from and
+    /// to how long after hearing it, or `None` for silence. A reply that
+    /// has not left when its slot ends is given up: a crowd's replies,
+    /// each waiting for the line to be quiet (the modem's "not now"),
+    /// would otherwise spill over the frame's end onto the next request.
+    pub fn on_request(&mut self, me: &Address, service: &Service) -> Option<Range<Duration>> {
         let bare;
         let frame = match service {
             Service::DiscoverAny => {
@@ -329,7 +333,11 @@ impl Responder {
                 return None;
             }
         }
-        reply_slot(me, frame).map(|slot| slot as u64 * frame.slot_ms as u64 * MS)
+        let slot_len = frame.slot_ms as u64 * MS;
+        reply_slot(me, frame).map(|slot| {
+            let start = slot as u64 * slot_len;
+            start..start + slot_len
+        })
     }
 }
 

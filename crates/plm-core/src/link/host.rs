@@ -270,6 +270,33 @@ impl HostEngine {
         ticket
     }
 
+    /// Drops a frame none of whose bytes has left: queued, or waiting for
+    /// the modem's leave (a "not now" status, UM0932 3.2.5). False once
+    /// it has begun: its fate then comes as an event. A frame withdrawn
+    /// gets none.
+    pub fn withdraw(&mut self, now: Instant, ticket: Ticket) -> bool {
+        if let Some(i) = self.queue.iter().position(|p| p.ticket == ticket) {
+            self.queue.remove(i);
+            return true;
+        }
+        let Some(p) = self.current.as_ref().filter(|p| p.ticket == ticket) else {
+            return false;
+        };
+        match self.state {
+            State::Idle { .. } if p.attempts == 0 => {}
+            State::AwaitStatus { .. } if p.attempts == 1 => {
+                self.transmits.push_back(Transmit::TReq { asserted: false });
+                self.state = State::Idle {
+                    not_before: now + self.again_after,
+                };
+            }
+            _ => return false,
+        }
+        self.current = None;
+        self.advance(now);
+        true
+    }
+
     /// Drops every queued frame and any exchange in flight (the port was
     /// lost or closed); each gets [`Event::Failed`] with `cause`.
     pub fn abort(&mut self, cause: LinkError) {
