@@ -401,9 +401,6 @@ impl Board {
             .is_some_and(|o| o.due.is_some_and(|d| d <= now))
         {
             let o = self.line_out.pop_front().expect("front exists");
-            if o.until.is_some_and(|u| u <= now) {
-                continue;
-            }
             let cmd = Command::DlDataRequest(DataRequest {
                 params: self.params,
                 payload: o.frame.emit(),

@@ -164,7 +164,8 @@ pub struct HostEngine {
     config: HostConfig,
     state: State,
     rx: Receiver,
-    queue: VecDeque<Pending>,
+    /// Frames waiting, oldest first (a few at most).
+    queue: Vec<Pending>,
     current: Option<Pending>,
     next_ticket: u32,
     transmits: VecDeque<Transmit>,
@@ -199,7 +200,7 @@ impl HostEngine {
             config,
             state: State::Idle { not_before: 0 },
             rx: Receiver::new(dialect, Source::Modem),
-            queue: VecDeque::new(),
+            queue: Vec::new(),
             current: None,
             next_ticket: 0,
             transmits: VecDeque::new(),
@@ -255,7 +256,7 @@ impl HostEngine {
         let ticket = Ticket(self.next_ticket);
         self.next_ticket = self.next_ticket.wrapping_add(1);
         match frame.emit(self.dialect) {
-            Ok(bytes) => self.queue.push_back(Pending {
+            Ok(bytes) => self.queue.push(Pending {
                 ticket,
                 bytes,
                 frame,
@@ -581,7 +582,7 @@ impl HostEngine {
             return;
         }
         if self.current.is_none() {
-            self.current = self.queue.pop_front();
+            self.current = (!self.queue.is_empty()).then(|| self.queue.remove(0));
         }
         let Some(p) = &mut self.current else { return };
         p.attempts += 1;
