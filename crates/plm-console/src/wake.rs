@@ -179,9 +179,10 @@ mod page {
         post();
     }
 
-    /// Frames painted so far.
+    /// Frames painted so far, one being counted included: a draw handed
+    /// out after its paint and before its message waits for the next.
     pub fn frames() -> u64 {
-        FRAMES.get()
+        FRAMES.get() + PAINTING.get() as u64
     }
 
     /// Whether a frame was painted since `frames` were, or the page

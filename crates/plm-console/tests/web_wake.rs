@@ -79,7 +79,7 @@ async fn a_draw_holds_the_line_until_the_page_has_painted_a_frame() {
     // frame).
     next_frame().await;
     for _ in 0..20 {
-        if wake::frames() > before {
+        if wake::frames() > before && runs() > ran {
             break;
         }
         sleep(5).await;
@@ -90,6 +90,46 @@ async fn a_draw_holds_the_line_until_the_page_has_painted_a_frame() {
     assert!(runs() > ran, "the page ran after the paint");
     draw.settle();
     assert!(!draw.pending(), "painted: the line goes on");
+}
+
+/// A draw handed out in the moment between a frame's callbacks (the
+/// wake's among them) and the message that counts the frame: that frame
+/// was painted before the draw, which waits for the next.
+#[wasm_bindgen_test]
+async fn a_draw_handed_out_as_a_frame_is_counted_waits_for_the_next() {
+    install();
+    next_frame().await;
+    sleep(5).await;
+    let before = wake::frames();
+    let mut first = Draw::default();
+    first.begin();
+    // The wake asks for a frame; this task's own callback runs after its.
+    first.settle();
+    next_frame().await;
+    let mut draw = Draw::default();
+    draw.begin();
+    for _ in 0..20 {
+        first.settle();
+        if !first.pending() {
+            break;
+        }
+        sleep(5).await;
+    }
+    assert!(!first.pending(), "the frame counted");
+    draw.settle();
+    assert!(
+        draw.pending(),
+        "painted before the draw: {} frames, {before} before",
+        wake::frames()
+    );
+    for _ in 0..20 {
+        draw.settle();
+        if !draw.pending() {
+            break;
+        }
+        sleep(5).await;
+    }
+    assert!(!draw.pending(), "the next frame counted");
 }
 
 /// Work that asks to run again 50 µs on, less than the page's clock's step
