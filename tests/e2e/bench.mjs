@@ -187,12 +187,13 @@ function spreadOf(xs) {
 }
 
 /**
- * What the page's main thread did while each late ACK waited: the reads
- * run again under Chromium's tracing; for each ACK later than LATE_MS,
- * the trace's tasks, garbage collections and rendering between the
- * frame's last byte (on the page's clock) and the tick that ACKed it.
+ * What the page's main thread did while each late ACK waited: `run`
+ * (`what` names it) runs under Chromium's tracing; for each ACK later
+ * than LATE_MS, the trace's tasks, garbage collections and rendering
+ * between the frame's last byte (on the page's clock) and the tick that
+ * ACKed it.
  */
-async function lateCauses(browser, page, reads) {
+async function lateCauses(browser, page, run, what) {
   const before = await page.evaluate(() => window.plmBench.ackLatency().count);
   await browser.startTracing(page, {
     categories: ['devtools.timeline', 'disabled-by-default-devtools.timeline', 'v8', 'blink.user_timing', 'toplevel'],
@@ -201,7 +202,7 @@ async function lateCauses(browser, page, reads) {
     performance.mark('plm-bench-sync');
     return performance.getEntriesByName('plm-bench-sync').at(-1).startTime;
   });
-  await reads(READS, true);
+  await run();
   const samples = await page.evaluate(() => window.plmBench.ackSamples());
   const after = await page.evaluate(() => window.plmBench.ackLatency().count);
   const trace = JSON.parse((await browser.stopTracing()).toString());
@@ -250,7 +251,7 @@ async function lateCauses(browser, page, reads) {
   }
   const all = spreadOf(newest.map(([, , p]) => p));
   return [
-    `ACKs later than ${LATE_MS} ms under tracing (${READS} chained reads, ${newest.length} ACKs, page p50 ${msText(all.p50)} p99 ${msText(all.p99)} max ${msText(all.max)}): ${late.length}`,
+    `ACKs later than ${LATE_MS} ms under tracing (${what}, from ${sync.toFixed(0)} ms of the page's clock, ${newest.length} ACKs, page p50 ${msText(all.p50)} p99 ${msText(all.p99)} max ${msText(all.max)}): ${late.length}`,
     `  by what the main thread did meanwhile: ${Object.entries(causes).map(([k, v]) => `${k} ${v}`).join(', ')}`,
     '  (idle: the thread ran nothing between the byte and the tick: the wake itself came late)',
     ...lines.slice(0, 40),
@@ -350,7 +351,7 @@ async function modemBench(browser, base, chip) {
   const chained = await checked(reads(READS, true), 'chained reads');
   const ack = await page.evaluate(() => window.plmBench.ackLatency());
   const noise = await wakeNoise(page);
-  const causes = process.env.PLM_BENCH_CAUSES === '1' ? await lateCauses(browser, page, reads) : [];
+  const causes = process.env.PLM_BENCH_CAUSES === '1' ? await lateCauses(browser, page, () => reads(READS, true), `${READS} chained reads`) : [];
   const load = os.loadavg();
   await page.screenshot({ path: path.join(artifacts, `bench-${chip.profile}.png`) });
   // The same chained reads with the Traffic table on screen, its rows
@@ -373,13 +374,20 @@ async function modemBench(browser, base, chip) {
 }
 
 /** Lamps of the street whose bare modem's ACKs are timed. */
-const STREET_ACK_LAMPS = 100;
+const STREET_ACK_LAMPS = 300;
+/**
+ * How long each of its windows is: about 300 frames at the street's pace,
+ * as many as the modem's Traffic window (a p99 of fewer than 100 frames
+ * is their largest).
+ */
+const STREET_ACK_WINDOW_MS = 30_000;
 
 /**
  * ACK latency of the console as the concentrator of a street over a bare
- * simulated ST7580, each window STREET_MEASURE_MS / 2 long: during
+ * simulated ST7580, each window STREET_ACK_WINDOW_MS long: during
  * discovery and during the sweep with the Street view on screen, then
- * the sweep with the Traffic table on screen.
+ * the sweep with the Traffic table on screen, once it has drawn its rows
+ * (the modem's Traffic window too starts after a warm-up).
  */
 async function streetAckBench(browser, base) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
@@ -387,7 +395,14 @@ async function streetAckBench(browser, base) {
   await page.goto(base + `?profile=concentrator&lamps=${STREET_ACK_LAMPS}#street`);
   await page.locator('#fleet-table').waitFor();
   await page.waitForFunction(() => window.plmBench !== undefined);
-  const window_ = () => page.waitForTimeout(STREET_MEASURE_MS / 2);
+  const wait = () => page.waitForTimeout(STREET_ACK_WINDOW_MS);
+  // Under PLM_BENCH_CAUSES, each window is traced and its late ACKs told.
+  const causes = [];
+  const traced = process.env.PLM_BENCH_CAUSES === '1';
+  const window_ = async () => {
+    if (!traced) return wait();
+    causes.push(...(await lateCauses(browser, page, wait, await progress())));
+  };
   const progress = () => page.textContent('#street-progress');
   const discoveryWas = await progress();
   const discovery = await ackSpreadOf(page, window_);
@@ -398,16 +413,18 @@ async function streetAckBench(browser, base) {
   const sweepWas = await progress();
   const sweep = await ackSpreadOf(page, window_);
   await page.click('#tab-traffic');
+  await page.locator('#traffic-table td.title').first().waitFor();
+  await page.waitForTimeout(1_000);
   const traffic = await ackSpreadOf(page, window_);
   const ack = await page.evaluate(() => window.plmBench.ackLatency());
   await page.screenshot({ path: path.join(artifacts, 'bench-street-concentrator.png') });
   await page.close();
   if (errors.length) throw new Error(`errors in the street page: ${errors.join('; ')}`);
-  return { discovery, discoveryWas, sweep, sweepWas, traffic, ack };
+  return { discovery, discoveryWas, sweep, sweepWas, traffic, ack, causes };
 }
 
 /** The report's lines for the street over a bare modem. */
-function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack }, spread) {
+function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack, causes }, spread) {
   const ratio = (s) => (s.n ? `ratio ${(s.p99 / ACK_P99_MS).toFixed(2)} of the ${ACK_P99_MS} ms p99 target` : 'no frame ACKed');
   const line = (s) => (s.n ? spread(s) : 'none');
   return [
@@ -417,6 +434,7 @@ function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack
     `  sweep          ${line(sweep)}   (${ratio(sweep)}; ${sweep.n} frames, Street view; from "${sweepWas}")`,
     `  Traffic view   ${line(traffic)}   (${ratio(traffic)}; ${traffic.n} frames of the sweep, the Traffic table on screen)`,
     `  virtual link   ${ack.count ? spread(ack.link) : 'none'}   (what the simulated modem saw, all frames)`,
+    ...causes,
   ];
 }
 
