@@ -42,6 +42,9 @@ pub fn catch_up(transport: &dyn Transport, acks: bool) -> Duration {
         _ => MAX_CATCH_UP,
     }
 }
+/// How soon after an ACK the line counts as just quiet, µs of the page's
+/// clock ([`Driver::just_acked`]): a tick or two.
+pub const JUST_ACKED_US: f64 = 2_000.0;
 /// How long one tick may keep the page busy, µs of the page's clock: past
 /// it the transport's time stops short of the page's and catches up at the
 /// next tick, so a simulated world the page cannot run in real time (a long
@@ -194,6 +197,16 @@ impl Driver {
     /// latency on the transport's clock and on the page's.
     pub fn ack_samples(&self) -> Vec<(f64, Duration, Duration)> {
         self.ack_times.samples()
+    }
+
+    /// Whether the host engine ACKed a frame of the modem within
+    /// [`JUST_ACKED_US`] of the page's clock `page_us`: the line is quiet
+    /// for a while then (the modem's next frame is the next power line
+    /// frame it hears, a slot or more later).
+    pub fn just_acked(&self, page_us: f64) -> bool {
+        self.ack_times
+            .last_written()
+            .is_some_and(|w| page_us - w <= JUST_ACKED_US)
     }
 
     /// Transport time the ticks have run (µs), and the page's time that

@@ -248,6 +248,19 @@ impl StreetSession {
         self.send(|s, conc, now| s.request(conc, now, request, reply))
     }
 
+    /// Whether the views' draw is under way at a quiet moment of the
+    /// line, to be painted before the street's next request
+    /// ([`StreetSession::draw_first`]).
+    pub fn drawing(&self) -> bool {
+        self.hold.pending()
+    }
+
+    /// Whether the discovery or the sweep has the line through a bare
+    /// modem: the views are drawn at its quiet moments.
+    pub fn busy_over_modem(&self) -> bool {
+        self.street.via_modem() && self.street.is_busy()
+    }
+
     /// Whether the street's next requests wait for the page: through a
     /// bare modem, while the views are to be drawn or a draw waits to be
     /// painted ([`StreetSession::draw_first`]).
@@ -304,18 +317,19 @@ impl StreetSession {
     /// What happened since the last call, without letting time pass, and
     /// whether the views are to be drawn at the page's clock `page_us`:
     /// through a bare modem, while the discovery or the sweep has the
-    /// line, at its quiet moments ([`StreetSession::draw_first`]) or after
-    /// [`STREET_DRAW_LATE_US`]; else at most every [`STREET_DRAW_US`].
+    /// line, at its quiet moments ([`StreetSession::draw_first`]) or, after
+    /// [`STREET_DRAW_LATE_US`], right after an ACK (a round's replies come
+    /// a slot apart: the draw is painted before the next frame ends);
+    /// else at most every [`STREET_DRAW_US`].
     pub fn hand_out(&mut self, page_us: f64) -> StreetTick {
-        let busy = self.street.via_modem() && self.street.is_busy();
-        let after = if busy {
-            STREET_DRAW_LATE_US
+        let (after, quiet) = if self.busy_over_modem() {
+            (STREET_DRAW_LATE_US, self.drive.just_acked(page_us))
         } else {
-            STREET_DRAW_US
+            (STREET_DRAW_US, true)
         };
         let mut tick = self.take();
         let changed = tick.changed || tick.sent > 0 || !tick.traffic.is_empty();
-        tick.show |= self.shown.show_after(changed, page_us, after);
+        tick.show |= quiet && self.shown.show_after(changed, page_us, after);
         // Counted on until the views show it; the street found is kept
         // then too (the browser's storage written at a quiet moment), and
         // the Traffic table's rows (a redraw of it while a modem's frame

@@ -93,6 +93,11 @@ impl AckTimes {
             .collect()
     }
 
+    /// When the last ACK was written (page's clock, µs).
+    pub(crate) fn last_written(&self) -> Option<f64> {
+        self.written.back().copied()
+    }
+
     pub(crate) fn stats(&self) -> AckLatency {
         AckLatency {
             count: self.count,

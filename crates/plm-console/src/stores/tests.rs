@@ -229,6 +229,13 @@ fn acks_with_redraws(draw_us: f64) -> (AckLatency, f64, usize) {
         let v = versions(c);
         rows_alone += (v.0 == version.0 && v.1 != version.1) as usize;
         if v != version {
+            // While discovery or the sweep has the line, a draw comes
+            // while its requests wait, or right after an ACK.
+            let now = crate::clock::page_now_us();
+            let quiet = c
+                .street
+                .read(|s| !s.busy_over_modem() || s.drawing() || s.driver().just_acked(now));
+            assert!(quiet, "a draw at {now} µs while the line may be busy");
             version = v;
             let now = crate::clock::page_now_us();
             if c.street.read(|s| s.discovering().is_some()) {
