@@ -360,8 +360,12 @@ async function modemBench(browser, base, chip) {
   await page.click('#tab-traffic');
   await checked(reads(WARM_UP, true), 'warm-up, Traffic view');
   let trafficReads;
-  const traffic = await ackSpreadOf(page, async () => {
+  const trafficRun = async () => {
     trafficReads = await checked(reads(READS, true), 'chained reads, Traffic view');
+  };
+  const traffic = await ackSpreadOf(page, async () => {
+    if (process.env.PLM_BENCH_CAUSES !== '1') return trafficRun();
+    causes.push(...(await lateCauses(browser, page, trafficRun, `${READS} chained reads, Traffic view`)));
   });
   await page.waitForFunction(
     (name) => [...document.querySelectorAll('#traffic-table td.title')].some((td) => td.textContent === name),
