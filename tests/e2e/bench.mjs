@@ -24,10 +24,12 @@
 //   against the 5× target.
 //
 // - ACK latency on the street over a bare simulated ST7580
-//   (`?profile=concentrator&lamps=100`): the console is the concentrator,
+//   (`?profile=concentrator&lamps=300`): the console is the concentrator,
 //   its host engine ACKs the modem's frames on the same drive loop as the
 //   modem session; while discovery runs and while the sweep reads, the
-//   Street view on screen, then the sweep with the Traffic table on screen.
+//   Street view on screen, then the sweep with the Traffic table on screen;
+//   then on a street of 20 while every lamp's firmware is updated, the
+//   Firmware update view on screen.
 //
 // The page is driven through `window.plmBench` (crates/plm-console/src/
 // bench_hook.rs), so the figures are the session's, not a script's clicks.
@@ -427,8 +429,48 @@ async function streetAckBench(browser, base) {
   return { discovery, discoveryWas, sweep, sweepWas, traffic, ack, causes };
 }
 
+/** Lamps updated over a bare modem while its ACKs are timed. */
+const UPDATE_ACK_LAMPS = 20;
+
+/**
+ * ACK latency of the console as the concentrator of a street over a bare
+ * simulated ST7580 while it updates every lamp's firmware (a generated
+ * image of 3 000 bytes), the Firmware update view on screen: from Start
+ * to the summary.
+ */
+async function updateAckBench(browser, base) {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  const errors = pageErrors(page);
+  await page.goto(base + `?profile=concentrator&lamps=${UPDATE_ACK_LAMPS}#street`);
+  await page.waitForFunction(
+    (n) => {
+      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
+    },
+    UPDATE_ACK_LAMPS,
+    { timeout: 120_000, polling: 250 },
+  );
+  await page.click('#tab-update');
+  await page.fill('#update-make-release', '1.5');
+  await page.fill('#update-make-size', '3000');
+  await page.click('#update-make');
+  await page.locator('#update-image', { hasText: 'release 1.5' }).waitFor();
+  await page.selectOption('#update-targets', 'all');
+  const started = Date.now();
+  const update = await ackSpreadOf(page, async () => {
+    await page.click('#update-start');
+    await page.locator('#update-summary', { hasText: 'took' }).waitFor({ timeout: 600_000 });
+  });
+  const took = (Date.now() - started) / 1000;
+  const summary = await page.textContent('#update-summary');
+  await page.screenshot({ path: path.join(artifacts, 'bench-update-concentrator.png') });
+  await page.close();
+  if (errors.length) throw new Error(`errors in the update page: ${errors.join('; ')}`);
+  return { update, took, summary };
+}
+
 /** The report's lines for the street over a bare modem. */
-function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack, causes }, spread) {
+function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack, causes }, { update, took, summary }, spread) {
   const ratio = (s) => (s.n ? `ratio ${(s.p99 / ACK_P99_MS).toFixed(2)} of the ${ACK_P99_MS} ms p99 target` : 'no frame ACKed');
   const line = (s) => (s.n ? spread(s) : 'none');
   return [
@@ -437,6 +479,7 @@ function streetAckLines({ discovery, discoveryWas, sweep, sweepWas, traffic, ack
     `  discovery      ${line(discovery)}   (${ratio(discovery)}; ${discovery.n} frames, Street view; from "${discoveryWas}")`,
     `  sweep          ${line(sweep)}   (${ratio(sweep)}; ${sweep.n} frames, Street view; from "${sweepWas}")`,
     `  Traffic view   ${line(traffic)}   (${ratio(traffic)}; ${traffic.n} frames of the sweep, the Traffic table on screen)`,
+    `  update         ${line(update)}   (${ratio(update)}; ${update.n} frames, Firmware update view, ${UPDATE_ACK_LAMPS} lamps: "${summary}", ${took.toFixed(0)} s)`,
     `  virtual link   ${ack.count ? spread(ack.link) : 'none'}   (what the simulated modem saw, all frames)`,
     ...causes,
   ];
@@ -484,6 +527,7 @@ async function main() {
     const modems = [];
     for (const chip of CHIPS) modems.push(await modemBench(browser, base, chip));
     const streetAck = await streetAckBench(browser, base);
+    const updateAck = await updateAckBench(browser, base);
     const street = process.env.PLM_BENCH_STREET === '0' ? null : await streetFrames(browser, base);
 
     const dsizes = await sizes();
@@ -498,7 +542,7 @@ async function main() {
       '',
       `PLM Console, Chromium ${browser.version()}, simulated modems at ${BAUD} baud`,
       ...modems.flatMap((m) => modemLines(m, spread)),
-      ...streetAckLines(streetAck, spread),
+      ...streetAckLines(streetAck, updateAck, spread),
       '',
       ...(street
         ? [
