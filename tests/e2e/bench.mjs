@@ -50,6 +50,7 @@ import os from 'node:os';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { artifacts, dist, launchChromium, serveDist, pageErrors } from './harness.mjs';
+import { everyLampRead } from './journeys.mjs';
 import { releaseWasm, report } from './wasm-contributors.mjs';
 
 const READS = Number(process.env.PLM_BENCH_READS ?? 300);
@@ -442,14 +443,7 @@ async function updateAckBench(browser, base) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
   const errors = pageErrors(page);
   await page.goto(base + `?profile=concentrator&lamps=${UPDATE_ACK_LAMPS}#street`);
-  await page.waitForFunction(
-    (n) => {
-      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
-    },
-    UPDATE_ACK_LAMPS,
-    { timeout: 120_000, polling: 250 },
-  );
+  await everyLampRead(page, UPDATE_ACK_LAMPS, { timeout: 120_000 });
   await page.click('#tab-update');
   await page.fill('#update-make-release', '1.5');
   await page.fill('#update-make-size', '3000');

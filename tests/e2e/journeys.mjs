@@ -10,6 +10,18 @@ import { artifacts } from './harness.mjs';
 /** The address of the simulated street's lamp `n` (plm_sim's street_address). */
 export const lamp = (n) => `0080e1${n.toString(16).padStart(6, '0')}`;
 
+/** Waits until the fleet table lists `n` lamps, every one read (`RUN`). */
+export async function everyLampRead(page, n, { timeout = 60_000, polling = 250 } = {}) {
+  await page.waitForFunction(
+    (count) => {
+      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
+      return cells.length === count && cells.every((c) => c.textContent === 'RUN');
+    },
+    n,
+    { timeout, polling },
+  );
+}
+
 /** Opens a view by its tab. */
 export async function tab(page, slug) {
   await page.click(`#tab-${slug}`);

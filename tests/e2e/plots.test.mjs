@@ -8,7 +8,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { browserSuite, watchedPage } from './harness.mjs';
-import { lamp, shot, tab } from './journeys.mjs';
+import { everyLampRead, lamp, shot, tab } from './journeys.mjs';
 
 const suite = browserSuite();
 
@@ -25,14 +25,7 @@ async function open(t, query = '', init = null) {
 
 /** Waits until every lamp is read, then opens lamp `n`'s page. */
 async function lampPage(page, n) {
-  await page.waitForFunction(
-    (count) => {
-      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-      return cells.length === count && cells.every((c) => c.textContent === 'RUN');
-    },
-    LAMPS,
-    { timeout: 60_000, polling: 250 },
-  );
+  await everyLampRead(page, LAMPS);
   await page.locator(`#fleet-table tbody tr[data-address="${lamp(n)}"]`).click();
   await page.locator('#plot-power').waitFor();
 }

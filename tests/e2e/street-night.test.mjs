@@ -11,7 +11,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import { browserSuite, watchedPage } from './harness.mjs';
-import { lamp, shot } from './journeys.mjs';
+import { everyLampRead, lamp, shot } from './journeys.mjs';
 
 const suite = browserSuite();
 
@@ -51,14 +51,7 @@ test('the demo street at 15 s and at 180 s: lamps that differ, a worn one failin
   await page.locator('#view-street').waitFor({ state: 'visible' });
 
   await until(page, 15);
-  await page.waitForFunction(
-    (n) => {
-      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
-    },
-    LAMPS,
-    { timeout: 60_000, polling: 100 },
-  );
+  await everyLampRead(page, LAMPS, { polling: 100 });
   const early = await streetSeconds(page);
   await shot(page, 'street-demo-15s');
   t.diagnostic(`first screenshot at ${early.toFixed(1)} s of simulated time`);

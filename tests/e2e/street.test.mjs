@@ -5,7 +5,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import { browserSuite, watchedPage } from './harness.mjs';
-import { lamp, shot, tab } from './journeys.mjs';
+import { everyLampRead, lamp, shot, tab } from './journeys.mjs';
 
 const suite = browserSuite();
 
@@ -14,11 +14,6 @@ const row = (page, n) => page.locator(`#fleet-table tbody tr[data-address="${lam
 const cell = (page, n, key) => row(page, n).locator(`td[data-key="${key}"]`);
 const number = async (page, n, key) => Number(await cell(page, n, key).textContent());
 
-/** The state cells of the fleet table, all read (`RUN`), `n` of them. */
-const allRead = (n) => {
-  const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-  return cells.length === n && cells.every((c) => c.textContent === 'RUN');
-};
 
 /**
  * Records in the page, at every frame drawn, what the Street view shows
@@ -62,7 +57,7 @@ async function open(t, meanwhile = async () => {}, query = '') {
   await page.goto(suite.base + query);
   await page.locator('#view-street').waitFor({ state: 'visible' });
   await meanwhile(page);
-  await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
+  await everyLampRead(page, LAMPS);
   return page;
 }
 
@@ -106,7 +101,7 @@ test('after a reload the known lamps are read at once, without a discovery; then
   // Every lamp is in the table before any is read.
   await page.waitForFunction((n) => document.querySelectorAll('#fleet-table tbody tr').length === n, LAMPS);
   await shot(page, 'street-reloaded');
-  await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
+  await everyLampRead(page, LAMPS);
   const filled = await filledAt(page);
   t.diagnostic(`after the reload every lamp's row filled at ${filled.toFixed(2)} s of page time`);
   assert.ok(filled <= 10, `every row filled at ${filled.toFixed(2)} s of page time after the reload`);
@@ -142,7 +137,7 @@ test('after a reload the known lamps are read at once, without a discovery; then
   await page.reload();
   await page.locator('#link-problem', { hasText: 'cannot be read (its session is not two hex digits); it is forgotten and the street is discovered again' }).waitFor();
   await page.locator('#street-progress', { hasText: 'discovering' }).waitFor();
-  await page.waitForFunction(allRead, LAMPS, { timeout: 60_000, polling: 250 });
+  await everyLampRead(page, LAMPS);
 });
 
 test('a column header sorts the fleet table by it, the other way on a second click', async (t) => {

@@ -6,7 +6,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs/promises';
 import { launchChromium, serveDist, watchedPage } from './harness.mjs';
-import { shot, tab } from './journeys.mjs';
+import { everyLampRead, shot, tab } from './journeys.mjs';
 
 let server;
 let base;
@@ -34,14 +34,7 @@ async function open(t, lamps = 12) {
   });
   const page = await watchedPage(t, context);
   await page.goto(`${base}?speed=10&lamps=${lamps}`);
-  await page.waitForFunction(
-    (n) => {
-      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-      return cells.length === n && cells.every((c) => c.textContent === 'RUN');
-    },
-    lamps,
-    { timeout: 60_000, polling: 250 },
-  );
+  await everyLampRead(page, lamps);
   return page;
 }
 

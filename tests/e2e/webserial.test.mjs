@@ -20,7 +20,7 @@ import readline from 'node:readline';
 import { spawn, spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { launchChromium, serveDist, pageErrors, watchedPage } from './harness.mjs';
-import { exportImport, macAsk, macClient, sendAlarm, phyRoundTrip, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
+import { everyLampRead, exportImport, macAsk, macClient, sendAlarm, phyRoundTrip, refusedFrequency, shot, ST7570_F, tab, titles } from './journeys.mjs';
 import { Rfc2217Client } from './rfc2217.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -528,14 +528,7 @@ test('WebSerial: a concentrator board on the port: its street is found, read and
   await connectSerial(page, { reset: false });
   assert.match(await page.textContent('#street-port'), /WebSerial/);
   // Discovery and the first sweep run over the real WebSerial transport.
-  await page.waitForFunction(
-    () => {
-      const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-      return cells.length === 6 && cells.every((c) => c.textContent === 'RUN');
-    },
-    null,
-    { timeout: 60_000, polling: 250 },
-  );
+  await everyLampRead(page, 6);
   const power = async () =>
     Number(await page.textContent('#fleet-table tr[data-address="0080e1000002"] td[data-key="power"]'));
   const before = await power();
@@ -555,15 +548,7 @@ test('WebSerial: a concentrator board on the port: its street is found, read and
 test('WebSerial: a firmware update over a real street survives a pulled cable and resumes where it was', async (t) => {
   const { page, wire } = await open(t, { world: ['--board', '--street', '3', '--seed', '5'], profile: 'board' });
   await connectSerial(page, { reset: false });
-  const lit = (n) =>
-    page.waitForFunction(
-      (count) => {
-        const cells = [...document.querySelectorAll('#fleet-table tbody td[data-key="state"]')];
-        return cells.length === count && cells.every((c) => c.textContent === 'RUN');
-      },
-      n,
-      { timeout: 90_000, polling: 250 },
-    );
+  const lit = (n) => everyLampRead(page, n, { timeout: 90_000 });
   await lit(3);
   await tab(page, 'update');
   await page.fill('#update-make-release', '1.6');
