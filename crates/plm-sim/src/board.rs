@@ -77,7 +77,7 @@ pub struct BoardConfig {
 /// A line frame the firmware made: when, when it goes to the modem
 /// (drawn with [`FIRMWARE_JITTER`] before the board's turn ends), and
 /// when it is given up if it has not left by then (a discovery reply at
-/// its slot's end, [`Responder::on_request`]).
+/// the end of its frame's slots, [`Responder::on_request`]).
 #[derive(Debug, Clone)]
 struct LineOut {
     made: Instant,

@@ -127,7 +127,7 @@ fn a_street_of_50_through_a_bare_modem() {
 /// now"); a crowd's replies used to spill past their frame onto the next
 /// request, which no board then heard, and the silence ended the
 /// discovery with 1 lamp of 300 found (seed 7). A reply not gone by its
-/// slot's end is given up now ([`Responder::on_request`]).
+/// frame's slots' end is given up now ([`Responder::on_request`]).
 ///
 /// [`Responder::on_request`]: plm_core::app::discovery::Responder::on_request
 #[test]

@@ -303,11 +303,12 @@ pub struct Responder {
 }
 
 impl Responder {
-    /// A discovery request heard (rule 2, or bare): its slot, from and
-    /// to how long after hearing it, or `None` for silence. A reply that
-    /// has not left when its slot ends is given up: a crowd's replies,
-    /// each waiting for the line to be quiet (the modem's "not now"),
-    /// would otherwise spill over the frame's end onto the next request.
+    /// A discovery request heard (rule 2, or bare): when to answer it and
+    /// when to give the reply up, how long after hearing it (its slot's
+    /// start and the frame's last slot's end), or `None` for silence. A
+    /// reply late for its slot, having waited for the line to be quiet
+    /// (the modem's "not now"), may still be heard in a free one; past
+    /// the frame, a crowd's replies would spill onto the next request.
     pub fn on_request(&mut self, me: &Address, service: &Service) -> Option<Range<Duration>> {
         let bare;
         let frame = match service {
@@ -334,10 +335,7 @@ impl Responder {
             }
         }
         let slot_len = frame.slot_ms as u64 * MS;
-        reply_slot(me, frame).map(|slot| {
-            let start = slot as u64 * slot_len;
-            start..start + slot_len
-        })
+        reply_slot(me, frame).map(|slot| slot as u64 * slot_len..frame.slots as u64 * slot_len)
     }
 }
 
