@@ -108,28 +108,26 @@ async fn a_draw_handed_out_as_a_frame_is_counted_waits_for_the_next() {
     next_frame().await;
     let mut draw = Draw::default();
     draw.begin();
-    for _ in 0..20 {
-        first.settle();
-        if !first.pending() {
-            break;
-        }
-        sleep(5).await;
-    }
-    assert!(!first.pending(), "the frame counted");
+    assert!(settled(&mut first).await, "the frame counted");
     draw.settle();
     assert!(
         draw.pending(),
         "painted before the draw: {} frames, {before} before",
         wake::frames()
     );
+    assert!(settled(&mut draw).await, "the next frame counted");
+}
+
+/// Whether `draw`'s wait ends within 100 ms.
+async fn settled(draw: &mut Draw) -> bool {
     for _ in 0..20 {
         draw.settle();
         if !draw.pending() {
-            break;
+            return true;
         }
         sleep(5).await;
     }
-    assert!(!draw.pending(), "the next frame counted");
+    false
 }
 
 /// Work that asks to run again 50 µs on, less than the page's clock's step
