@@ -237,7 +237,6 @@ fn acks_with_redraws(draw_us: f64) -> (AckLatency, f64, usize) {
                 .read(|s| !s.busy_over_modem() || s.drawing() || s.driver().just_acked(now));
             assert!(quiet, "a draw at {now} µs while the line may be busy");
             version = v;
-            let now = crate::clock::page_now_us();
             if c.street.read(|s| s.discovering().is_some()) {
                 longest = longest.max(now - drawn);
             }
