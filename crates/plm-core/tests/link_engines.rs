@@ -1043,6 +1043,11 @@ fn status_transmitting() -> plm_core::link::StatusMessage {
     plm_core::link::StatusMessage::new(Dialect::St7580, &[0x02])
 }
 
+/// UM0932 Table 8 bit 2: a power line frame is being received.
+fn status_receiving() -> plm_core::link::StatusMessage {
+    plm_core::link::StatusMessage::new(Dialect::St7580, &[0x04])
+}
+
 #[test]
 fn modem_takes_no_frame_after_a_not_now_status() {
     // A host that sends whatever the status says (no "not now" bits).
@@ -1109,9 +1114,8 @@ fn host_waits_for_a_status_that_is_not_not_now() {
 #[test]
 fn host_gives_up_on_a_modem_busy_for_good() {
     let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
-    // Bit 2: a power line frame is being received, for ever.
-    sim.dev
-        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x04]));
+    // Received for ever.
+    sim.dev.set_status(status_receiving());
     let ticket = sim.submit(ping());
     sim.run_until(3_000 * MS);
     let failed = sim.host_events_where(is_failed);
@@ -1130,9 +1134,7 @@ fn host_gives_up_on_a_modem_busy_for_good() {
 #[test]
 fn a_frame_the_modem_has_not_let_out_yet_can_be_withdrawn() {
     let mut sim = Sim::with_baud(BAUD).responder(ping_responder());
-    // Bit 2: a power line frame is being received.
-    sim.dev
-        .set_status(plm_core::link::StatusMessage::new(Dialect::St7580, &[0x04]));
+    sim.dev.set_status(status_receiving());
     let waiting = sim.submit(ping());
     let queued = sim.submit(ping());
     sim.run_until(20 * MS);
